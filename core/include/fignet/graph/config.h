@@ -1,0 +1,42 @@
+// Every tunable of the input graph, in one struct that is saved inside model files.
+#pragma once
+
+namespace fignet {
+
+// How objects interact across the collision radius.
+enum class CollisionEdges {
+  kFaceFace,  // FIGNet: face–face hyper-edges between triangles (seed C.1.1)
+  kNodeNode,  // FIGNet-NoFaceCollision: MeshGraphNets "world edges" between mesh nodes (seed D.2)
+};
+
+// How the floor enters the graph.
+enum class FloorModel {
+  kMesh,      // a static object of 2·floor_segments² large triangles (seed C.1.1)
+  kImplicit,  // no floor object; mesh nodes carry [within d_c of the floor, height] (seed D.2)
+  kNone,      // no floor at all (the scene brings its own static geometry)
+};
+
+struct GraphConfig {
+  double collision_radius = 0.1;   // d_c in metres: faces of different objects closer than this
+  int history = 2;                 // h: velocities per node feature (h + 1 positions are needed)
+  bool object_nodes = true;        // false gives FIGNet-NoObjectNode
+  CollisionEdges collisions = CollisionEdges::kFaceFace;
+  FloorModel floor = FloorModel::kMesh;
+  double floor_half_extent = 40.0;  // the floor spans [-e, e]² (Kubric's dome bounds)
+  int floor_segments = 1;           // > 1 subdivides the floor mesh (MGN's "subdivided floor")
+
+  // Throws ConfigError naming the first invalid field and its value.
+  void validate() const;
+};
+
+// Feature widths of each node and edge type under `config` (seed C.1.1 with C.2's norms).
+struct FeatureSizes {
+  int mesh_node;    // h·(3+1) velocities, 3 static properties, kinematic flag, 3+1 next-step move
+  int object_node;  // as mesh nodes, at the centre of mass (no implicit-floor features)
+  int mesh_edge;    // [d, |d|, d_rest, |d_rest|] = 8; also object->mesh and mesh->object
+  int world_edge;   // [d, |d|] = 4 (node–node collision edges)
+  int face_edge;    // [d_rs, 3 sender spans, 3 receiver spans] with norms, n_r, n_s = 34
+};
+FeatureSizes feature_sizes(const GraphConfig& config);
+
+}  // namespace fignet

@@ -1,0 +1,62 @@
+// Builds the FIGNet input graph (seed C.1.1, C.2) of one or more scenes into a reusable Graph.
+// A builder holds the immutable config and the per-step scratch (hierarchies, pair lists), so one
+// builder per thread; a steady-state build allocates nothing.
+#pragma once
+
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "fignet/graph/config.h"
+#include "fignet/graph/contacts.h"
+#include "fignet/graph/graph.h"
+#include "fignet/graph/scene.h"
+
+namespace fignet {
+
+// The floor mesh used for FloorModel::kMesh: a flat square at z = 0 split into 2·segments²
+// triangles facing +z.
+TriangleMesh make_floor_mesh(double half_extent, int segments);
+
+class GraphBuilder {
+ public:
+  explicit GraphBuilder(const GraphConfig& config);
+
+  const GraphConfig& config() const { return config_; }
+  const FeatureSizes& sizes() const { return sizes_; }
+
+  // Builds the concatenated graph of `scenes`. Throws ConfigError naming the scene, object and
+  // field when an input is inconsistent (history length, missing kinematic targets, NaN).
+  void build(std::span<const Scene> scenes, Graph& graph);
+  void build(const Scene& scene, Graph& graph) { build(std::span(&scene, 1), graph); }
+
+  // Builds one scene with the object pairs to examine given by the caller (for example from a
+  // physics engine's broadphase) instead of the builder's own sweep. Object indices follow
+  // scene.objects, with the floor (when modelled as a mesh) at index scene.objects.size().
+  void build_with_candidates(const Scene& scene, std::span<const ObjectPair> candidates,
+                             Graph& graph);
+
+  // The face pairs found by the last build, with object indices into the graph's objects.
+  std::span<const FacePair> face_pairs() const { return face_pairs_; }
+
+ private:
+  void build_scenes(std::span<const Scene> scenes, const std::span<const ObjectPair>* candidates,
+                    Graph& graph);
+  void validate_scene(const Scene& scene, int scene_index) const;
+  const SceneObject& floor_object(const Scene& scene, int scene_index);
+
+  GraphConfig config_;
+  FeatureSizes sizes_;
+  TriangleMesh floor_mesh_;
+  // Scratch reused across builds.
+  std::vector<SceneObject> floor_objects_;
+  std::vector<const SceneObject*> objects_;
+  std::vector<const Floor*> object_floor_;
+  std::vector<PosedMesh> posed_;
+  ContactFinder contacts_;
+  std::vector<ObjectPair> pairs_, scene_pairs_;
+  std::vector<FacePair> face_pairs_, scene_face_pairs_;
+  std::vector<NodePair> node_pairs_;
+};
+
+}  // namespace fignet

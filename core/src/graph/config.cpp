@@ -1,0 +1,38 @@
+#include "fignet/graph/config.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "fignet/error.h"
+
+namespace fignet {
+
+void GraphConfig::validate() const {
+  auto fail = [](const char* field, auto value, const char* rule) {
+    throw ConfigError(fmt::format("graph config: {} = {} ({})", field, value, rule));
+  };
+  if (!(collision_radius > 0.0) || !std::isfinite(collision_radius)) {
+    fail("collision_radius", collision_radius, "must be a positive finite distance in metres");
+  }
+  if (history < 1 || history > 16) fail("history", history, "must be in 1..16");
+  if (!(floor_half_extent > 0.0) || !std::isfinite(floor_half_extent)) {
+    fail("floor_half_extent", floor_half_extent, "must be positive and finite");
+  }
+  if (floor_segments < 1 || floor_segments > 1024) {
+    fail("floor_segments", floor_segments, "must be in 1..1024");
+  }
+}
+
+FeatureSizes feature_sizes(const GraphConfig& config) {
+  const int dynamic_part = 4 * config.history + 3 + 1 + 4;
+  return {
+      .mesh_node = dynamic_part + (config.floor == FloorModel::kImplicit ? 2 : 0),
+      .object_node = dynamic_part,
+      .mesh_edge = 8,
+      .world_edge = 4,
+      .face_edge = 34,
+  };
+}
+
+}  // namespace fignet

@@ -1,0 +1,35 @@
+#include "fignet/graph/scene.h"
+
+#include "fignet/error.h"
+
+namespace fignet {
+
+namespace {
+
+void write_posed(const TriangleMesh& mesh, const Pose& pose, Eigen::Ref<Points> out) {
+  const Eigen::Matrix3d rotation = pose.orientation.normalized().toRotationMatrix();
+  out.noalias() = mesh.vertices() * rotation.transpose();
+  out.rowwise() += pose.position.transpose();
+}
+
+}  // namespace
+
+void set_pose_history(SceneObject& object, std::span<const Pose> poses,
+                      const std::optional<Pose>& next_pose) {
+  if (object.mesh == nullptr) throw ConfigError("set_pose_history: the object has no mesh");
+  if (poses.empty()) throw ConfigError("set_pose_history: needs at least one pose");
+  const Eigen::Index v = object.mesh->num_vertices();
+  object.positions.resize(v * static_cast<Eigen::Index>(poses.size()), 3);
+  object.centers.resize(static_cast<Eigen::Index>(poses.size()), 3);
+  for (size_t k = 0; k < poses.size(); ++k) {
+    write_posed(*object.mesh, poses[k], object.positions.middleRows(v * k, v));
+    object.centers.row(k) = poses[k].position.transpose();
+  }
+  if (next_pose) {
+    object.next_positions.resize(v, 3);
+    write_posed(*object.mesh, *next_pose, object.next_positions);
+    object.next_center = next_pose->position;
+  }
+}
+
+}  // namespace fignet

@@ -1,0 +1,10 @@
+// Each subcommand of the `fignet` tool registers itself on the top-level app.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace fignet::cli {
+
+void add_graph_stats_command(CLI::App& app);
+
+}  // namespace fignet::cli
