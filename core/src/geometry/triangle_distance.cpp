@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
+#include <utility>
 
 namespace fignet {
 
@@ -93,23 +95,47 @@ void keep_if_closer(const Vec3& on_a, const Vec3& on_b, ClosestPoints* best) {
   if (distance < best->distance) *best = {on_a, on_b, distance};
 }
 
-// Where segment [p, q] crosses the plane of t, the crossing point and its closest point on t.
+// Where segment [p, q] crosses the plane of t: the crossing point and its closest point on t.
 // This catches intersections through a face interior, which no vertex or edge pair reveals.
+// Crossings inside t are points of the intersection; they are also collected in `inside`.
+// Each of the six edges crosses the other triangle at most once.
+struct Crossings {
+  std::array<Vec3, 6> points;
+  int count = 0;
+};
+
 void check_edge_crossing(const Vec3& p, const Vec3& q, const Triangle& t, bool edge_on_first,
-                         ClosestPoints* best) {
+                         ClosestPoints* best, Crossings* inside) {
   const Vec3 normal = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]);
   const double dp = normal.dot(p - t.v[0]), dq = normal.dot(q - t.v[0]);
   if (dp * dq > 0.0 || dp == dq) return;  // same side, or the segment lies in the plane
   const Vec3 crossing = p + (dp / (dp - dq)) * (q - p);
   Vec3 on_t = closest_point_on_triangle(crossing, t);
   // A crossing inside the face is an intersection; rounding must not turn it into 1e-17 m.
-  const double scale = std::max({(t.v[1] - t.v[0]).norm(), (t.v[2] - t.v[0]).norm(), (q - p).norm()});
-  if ((crossing - on_t).norm() <= 1e-12 * scale) on_t = crossing;
+  const double scale =
+      std::max({(t.v[1] - t.v[0]).norm(), (t.v[2] - t.v[0]).norm(), (q - p).norm()});
+  if ((crossing - on_t).norm() <= 1e-12 * scale) {
+    on_t = crossing;
+    inside->points[inside->count++] = crossing;
+  }
   if (edge_on_first) {
     keep_if_closer(crossing, on_t, best);
   } else {
     keep_if_closer(on_t, crossing, best);
   }
+}
+
+// The midpoint of the two crossings farthest apart: the middle of the intersection segment.
+Vec3 intersection_midpoint(const Crossings& crossings) {
+  std::pair<int, int> ends{0, 0};
+  double longest = -1.0;
+  for (int i = 0; i < crossings.count; ++i) {
+    for (int j = i; j < crossings.count; ++j) {
+      const double d = (crossings.points[i] - crossings.points[j]).squaredNorm();
+      if (d > longest) longest = d, ends = {i, j};
+    }
+  }
+  return 0.5 * (crossings.points[ends.first] + crossings.points[ends.second]);
 }
 
 }  // namespace
@@ -120,6 +146,7 @@ ClosestPoints closest_points_triangles(const Triangle& a, const Triangle& b) {
   // vertex–face pair at distance 0). Every candidate is a valid pair of points, so the minimum
   // over all of them is exact.
   ClosestPoints best{a.v[0], b.v[0], INFINITY};
+  Crossings crossings;
   for (int i = 0; i < 3; ++i) {
     keep_if_closer(a.v[i], closest_point_on_triangle(a.v[i], b), &best);
     keep_if_closer(closest_point_on_triangle(b.v[i], a), b.v[i], &best);
@@ -130,10 +157,17 @@ ClosestPoints closest_points_triangles(const Triangle& a, const Triangle& b) {
       const ClosestPoints cp = closest_points_segments(a0, a1, b.v[j], b.v[(j + 1) % 3]);
       if (cp.distance < best.distance) best = cp;
     }
-    check_edge_crossing(a0, a1, b, /*edge_on_first=*/true, &best);
-    check_edge_crossing(b.v[i], b.v[(i + 1) % 3], a, /*edge_on_first=*/false, &best);
+    check_edge_crossing(a0, a1, b, /*edge_on_first=*/true, &best, &crossings);
+    check_edge_crossing(b.v[i], b.v[(i + 1) % 3], a, /*edge_on_first=*/false, &best, &crossings);
   }
-  // An intersection point lies on both triangles: report it once, as the same point.
+  // Crossing triangles meet along a segment, and any point of it is a closest point. Report its
+  // midpoint: it depends on the geometry alone, not on the order of vertices or triangles, which
+  // keeps face-face features permutation-equivariant for interpenetrating objects.
+  if (crossings.count > 0) {
+    const Vec3 middle = intersection_midpoint(crossings);
+    return {middle, middle, 0.0};
+  }
+  // A touching point lies on both triangles: report it once, as the same point.
   if (best.distance == 0.0) best.on_second = best.on_first;
   return best;
 }

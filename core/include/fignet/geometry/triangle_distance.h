@@ -23,8 +23,8 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Triangle& t);
 ClosestPoints closest_points_segments(const Vec3& p0, const Vec3& p1, const Vec3& q0,
                                       const Vec3& q1);
 
-// Closest points between two triangles. When they intersect the distance is 0 and both points
-// are the same point of the intersection.
+// Closest points between two triangles. When they cross, the distance is 0 and both points are
+// the midpoint of their intersection segment (a choice independent of vertex order).
 ClosestPoints closest_points_triangles(const Triangle& a, const Triangle& b);
 
 }  // namespace fignet
