@@ -31,7 +31,8 @@ void add_info_command(CLI::App& app) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"FIGNet: learned rigid-body simulation (Face Interaction Graph Networks) for Bullet"};
+  CLI::App app{
+      "FIGNet: learned rigid-body simulation (Face Interaction Graph Networks) for Bullet"};
   app.require_subcommand(1);
   app.set_version_flag("--version", FIGNET_VERSION);
   add_info_command(app);

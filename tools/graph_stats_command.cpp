@@ -70,15 +70,14 @@ void add_graph_stats_command(CLI::App& app) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--seed", options->scene.seed, "Random seed of the scene")->capture_default_str();
-  cmd->add_option("--radius", options->graph.collision_radius,
-                  "Collision radius d_c in metres")
+  cmd->add_option("--radius", options->graph.collision_radius, "Collision radius d_c in metres")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--history", options->graph.history, "Velocities in node features (h)")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
-  const std::map<std::string, CollisionEdges> collisions = {
-      {"face", CollisionEdges::kFaceFace}, {"node", CollisionEdges::kNodeNode}};
+  const std::map<std::string, CollisionEdges> collisions = {{"face", CollisionEdges::kFaceFace},
+                                                            {"node", CollisionEdges::kNodeNode}};
   cmd->add_option("--collisions", options->graph.collisions,
                   "face: face-face edges (FIGNet); node: node-node world edges (NoFaceCollision)")
       ->transform(CLI::CheckedTransformer(collisions, CLI::ignore_case));

@@ -55,8 +55,7 @@ TEST(TriangleMesh, OpenAndInconsistentMeshesAreNotClosed) {
 TEST(TriangleMesh, RejectsNonFiniteVertexNamingIt) {
   Points v = tetrahedron_vertices();
   v(2, 1) = NAN;
-  const std::string message =
-      mesh_error([&] { TriangleMesh("bad", v, tetrahedron_faces()); });
+  const std::string message = mesh_error([&] { TriangleMesh("bad", v, tetrahedron_faces()); });
   EXPECT_NE(message.find("mesh 'bad'"), std::string::npos) << message;
   EXPECT_NE(message.find("vertex 2"), std::string::npos) << message;
 }
@@ -71,8 +70,9 @@ TEST(TriangleMesh, RejectsIndexOutOfRange) {
 }
 
 TEST(TriangleMesh, RejectsNoFacesAndRepeatedVertices) {
-  EXPECT_NE(mesh_error([] { TriangleMesh("empty", tetrahedron_vertices(), Triangles(0, 3)); })
-                .find("no faces"),
+  EXPECT_NE(mesh_error([] {
+              TriangleMesh("empty", tetrahedron_vertices(), Triangles(0, 3));
+            }).find("no faces"),
             std::string::npos);
   Triangles f = tetrahedron_faces();
   f.row(2) << 1, 1, 3;

@@ -15,7 +15,9 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 // Area of a regular n-gon inscribed in a circle of radius r.
-double regular_polygon_area(int n, double r) { return 0.5 * n * r * r * std::sin(2 * kPi / n); }
+double regular_polygon_area(int n, double r) {
+  return 0.5 * n * r * r * std::sin(2 * kPi / n);
+}
 
 TEST(Shapes, EveryMoviShapeIsClosedWithPositiveVolume) {
   for (const std::string& name : movi_shape_names()) {
@@ -60,7 +62,8 @@ TEST(MassProperties, BoxIsExact) {
   const Eigen::Vector3d expected(side.y() * side.y() + side.z() * side.z(),
                                  side.x() * side.x() + side.z() * side.z(),
                                  side.x() * side.x() + side.y() * side.y());
-  EXPECT_TRUE(props.inertia.isApprox(Eigen::Matrix3d((volume / 12 * expected).asDiagonal()), 1e-12));
+  EXPECT_TRUE(
+      props.inertia.isApprox(Eigen::Matrix3d((volume / 12 * expected).asDiagonal()), 1e-12));
 }
 
 TEST(MassProperties, PrismsAndPyramidsMatchTheirFormulas) {
@@ -89,7 +92,8 @@ TEST(MassProperties, PrismsAndPyramidsMatchTheirFormulas) {
 }
 
 TEST(MassProperties, FineMeshesConvergeToSmoothShapes) {
-  EXPECT_NEAR(compute_mass_properties(make_sphere(1.0, 48, 96)).volume / (4.0 / 3 * kPi), 1.0, 0.01);
+  EXPECT_NEAR(compute_mass_properties(make_sphere(1.0, 48, 96)).volume / (4.0 / 3 * kPi), 1.0,
+              0.01);
   EXPECT_NEAR(compute_mass_properties(make_cylinder(1.0, 1.0, 96)).volume / (2 * kPi), 1.0, 0.01);
   EXPECT_NEAR(compute_mass_properties(make_cone(1.0, 2.0, 96)).volume / (2 * kPi / 3), 1.0, 0.01);
   const double torus = 2 * kPi * kPi * 0.7 * 0.3 * 0.3;

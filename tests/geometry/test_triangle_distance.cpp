@@ -27,8 +27,8 @@ std::vector<Vec3> sample(const Triangle& t) {
 
 // Every point of a triangle lies within this distance of one of its samples.
 double sampling_resolution(const Triangle& t) {
-  const double longest = std::max({(t.v[1] - t.v[0]).norm(), (t.v[2] - t.v[0]).norm(),
-                                   (t.v[2] - t.v[1]).norm()});
+  const double longest =
+      std::max({(t.v[1] - t.v[0]).norm(), (t.v[2] - t.v[0]).norm(), (t.v[2] - t.v[1]).norm()});
   return longest / kSamplesPerEdge;
 }
 
@@ -161,7 +161,8 @@ TEST(TriangleDistance, PointLikeAndSegmentLikeTrianglesWork) {
 
 TEST(SegmentDistance, ParallelAndDegenerateSegments) {
   EXPECT_DOUBLE_EQ(
-      closest_points_segments(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, 1, 0), Vec3(2, 1, 0)).distance,
+      closest_points_segments(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, 1, 0), Vec3(2, 1, 0))
+          .distance,
       1.0);
   EXPECT_DOUBLE_EQ(
       closest_points_segments(Vec3(0, 0, 0), Vec3(0, 0, 0), Vec3(3, 4, 0), Vec3(3, 4, 0)).distance,

@@ -32,8 +32,8 @@ inline RandomScene make_random_scene(unsigned seed, int objects, double spread, 
   for (int i = 0; i < objects; ++i) {
     const TriangleMesh unit = centered_on_center_of_mass(make_movi_shape(shapes[i % 4]));
     const double scale = 0.3 + 0.1 * u(rng);
-    auto mesh = std::make_shared<const TriangleMesh>(unit.name(), unit.vertices() * scale,
-                                                     unit.faces());
+    auto mesh =
+        std::make_shared<const TriangleMesh>(unit.name(), unit.vertices() * scale, unit.faces());
     result.meshes.push_back(mesh);
     SceneObject object;
     object.mesh = mesh.get();

@@ -18,8 +18,8 @@ using Key = std::tuple<int, int, int, int>;
 std::vector<PosedMesh> posed_current(const Scene& scene, int history) {
   std::vector<PosedMesh> posed;
   for (const SceneObject& o : scene.objects) {
-    posed.push_back({o.mesh, o.positions.data() + size_t(history) * o.mesh->num_vertices() * 3,
-                     o.kinematic});
+    posed.push_back(
+        {o.mesh, o.positions.data() + size_t(history) * o.mesh->num_vertices() * 3, o.kinematic});
   }
   return posed;
 }
@@ -79,7 +79,9 @@ TEST(ContactFinder, RefitOnMovedObjectsMatchesBruteForce) {
   ContactFinder finder;
   finder.update(posed_current(fixture.scene, 2), false);
   // Move every object by a rigid shift; the second update refits instead of rebuilding.
-  for (auto& object : fixture.scene.objects) object.positions.rowwise() += Eigen::RowVector3d(0.1, -0.2, 0.05) * (object.properties.mass + 1);
+  for (auto& object : fixture.scene.objects)
+    object.positions.rowwise() +=
+        Eigen::RowVector3d(0.1, -0.2, 0.05) * (object.properties.mass + 1);
   const auto posed = posed_current(fixture.scene, 2);
   finder.update(posed, false);
   std::vector<ObjectPair> candidates;

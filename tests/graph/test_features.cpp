@@ -1,11 +1,11 @@
 // Feature values of a two-tetrahedra scene, derived by hand (see the comments), and batching.
 //
-// Both objects share the tetrahedron (0,0,0),(1,0,0),(0,1,0),(0,0,1) expressed in its centre-of-mass
-// frame (shifted by -1/4 on each axis). A is dynamic and translates along x: centres 0, 0.01, 0.03
-// at t-2, t-1, t. B is kinematic and static until it moves +0.001 in z at t+1; its apex (vertex 3)
-// points up at A's bottom face (z = -1/4 in A's frame), 0.05 m below the point (0.1, 0.05) of it.
-// With d_c = 0.1 exactly three face pairs are within range: A's bottom face with each of the three
-// faces of B around its apex.
+// Both objects share the tetrahedron (0,0,0),(1,0,0),(0,1,0),(0,0,1) expressed in its
+// centre-of-mass frame (shifted by -1/4 on each axis). A is dynamic and translates along x: centres
+// 0, 0.01, 0.03 at t-2, t-1, t. B is kinematic and static until it moves +0.001 in z at t+1; its
+// apex (vertex 3) points up at A's bottom face (z = -1/4 in A's frame), 0.05 m below the point
+// (0.1, 0.05) of it. With d_c = 0.1 exactly three face pairs are within range: A's bottom face with
+// each of the three faces of B around its apex.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -39,8 +39,7 @@ class TwoTetrahedra : public ::testing::Test {
     b.mesh = &mesh_;
     b.kinematic = true;
     b.properties = {0.0, 0.8, 0.7};
-    set_pose_history(b, std::vector<Pose>(3, Pose{center_b}),
-                     Pose{center_b + Vec3(0, 0, 0.001)});
+    set_pose_history(b, std::vector<Pose>(3, Pose{center_b}), Pose{center_b + Vec3(0, 0, 0.001)});
     scene_.objects = {a, b};
     GraphBuilder(GraphConfig{}).build(scene_, graph_);
   }
@@ -128,15 +127,15 @@ TEST_F(TwoTetrahedra, FaceFaceEdgeFromABottomToBsSideFace) {
   EXPECT_EQ(graph_.face_edges.receivers[3 * edge + 2], 6);
   auto norm = [](double x, double y, double z) { return std::sqrt(x * x + y * y + z * z); };
   expect_row(graph_.face_edges.features.row(edge),
-             {0, 0, -0.05, 0.05,                               // p_r - p_s
-              -0.35, -0.30, 0, norm(0.35, 0.3, 0),             // sender spans x_sj - p_s
-              0.65, -0.30, 0, norm(0.65, 0.3, 0),              //
-              -0.35, 0.70, 0, norm(0.35, 0.7, 0),              //
-              0, 0, 0, 0,                                      // receiver spans x_rj - p_r
-              0, 0, -1, 1,                                     //
-              0, 1, -1, std::sqrt(2.0),                        //
-              -1, 0, 0,                                        // n_r: B's face, outward -x
-              0, 0, -1});                                      // n_s: A's bottom, outward -z
+             {0,     0,     -0.05, 0.05,                // p_r - p_s
+              -0.35, -0.30, 0,     norm(0.35, 0.3, 0),  // sender spans x_sj - p_s
+              0.65,  -0.30, 0,     norm(0.65, 0.3, 0),  //
+              -0.35, 0.70,  0,     norm(0.35, 0.7, 0),  //
+              0,     0,     0,     0,                   // receiver spans x_rj - p_r
+              0,     0,     -1,    1,                   //
+              0,     1,     -1,    std::sqrt(2.0),      //
+              -1,    0,     0,                          // n_r: B's face, outward -x
+              0,     0,     -1});                       // n_s: A's bottom, outward -z
 }
 
 TEST_F(TwoTetrahedra, ReverseEdgeSwapsRoles) {
@@ -172,7 +171,8 @@ TEST(GraphBuilder, FloorMeshAndImplicitFloor) {
     const float* row = graph.mesh_nodes.row(i);
     const int object = graph.node_object[i];
     const int local = i - graph.object_first_node[object];
-    const double z = fixture.scene.objects[object].positions(2 * fixture.scene.objects[object].mesh->num_vertices() + local, 2);
+    const double z = fixture.scene.objects[object].positions(
+        2 * fixture.scene.objects[object].mesh->num_vertices() + local, 2);
     EXPECT_EQ(row[16], z < 0.1 ? 1.0f : 0.0f);
     EXPECT_FLOAT_EQ(row[17], z < 0.1 ? float(z) : 0.0f);
     near += z < 0.1;

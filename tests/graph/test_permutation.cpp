@@ -1,5 +1,5 @@
-// Reordering vertices within faces, faces within a mesh, vertices within a mesh, or objects within a
-// scene gives the same graph up to that permutation (seed C.1.1: sorting face nodes by distance
+// Reordering vertices within faces, faces within a mesh, vertices within a mesh, or objects within
+// a scene gives the same graph up to that permutation (seed C.1.1: sorting face nodes by distance
 // to the closest point makes the model permutation-equivariant).
 #include <gtest/gtest.h>
 
@@ -24,7 +24,9 @@ struct CanonicalGraph {
   std::map<std::pair<std::vector<NodeId>, std::vector<NodeId>>, Features> face_edges;
 };
 
-Features row_of(const FeatureMatrix& m, int r) { return Features(m.row(r), m.row(r) + m.cols()); }
+Features row_of(const FeatureMatrix& m, int r) {
+  return Features(m.row(r), m.row(r) + m.cols());
+}
 
 // `node_id[i]` names global mesh node i; `object_id[o]` names global object o.
 CanonicalGraph canonical(const Graph& g, const std::vector<NodeId>& node_id,
@@ -155,14 +157,16 @@ class Permutation : public ::testing::Test {
 TEST_F(Permutation, VertexOrderWithinFaces) {
   std::mt19937 rng(1);
   Scene scene = fixture_.scene;
-  for (int o = 0; o < int(scene.objects.size()); ++o) permute_mesh(scene, o, rng, true, false, nullptr);
+  for (int o = 0; o < int(scene.objects.size()); ++o)
+    permute_mesh(scene, o, rng, true, false, nullptr);
   expect_same(reference_, build_canonical(scene, identity_order_, identity_vertices_));
 }
 
 TEST_F(Permutation, FaceOrderWithinMeshes) {
   std::mt19937 rng(2);
   Scene scene = fixture_.scene;
-  for (int o = 0; o < int(scene.objects.size()); ++o) permute_mesh(scene, o, rng, false, true, nullptr);
+  for (int o = 0; o < int(scene.objects.size()); ++o)
+    permute_mesh(scene, o, rng, false, true, nullptr);
   expect_same(reference_, build_canonical(scene, identity_order_, identity_vertices_));
 }
 

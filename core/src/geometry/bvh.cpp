@@ -53,7 +53,8 @@ void Bvh::refit_node(std::int32_t index, std::span<const Aabb> boxes) {
   Node& node = nodes_[index];
   Aabb box;
   if (node.is_leaf()) {
-    for (std::int32_t i = node.first; i < node.first + node.count; ++i) box.extend(boxes[order_[i]]);
+    for (std::int32_t i = node.first; i < node.first + node.count; ++i)
+      box.extend(boxes[order_[i]]);
   } else {
     refit_node(node.first, boxes);
     refit_node(node.right, boxes);

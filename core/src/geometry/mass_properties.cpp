@@ -21,8 +21,9 @@ TetrahedronIntegrals integrate_tetrahedron(const Vec3& a, const Vec3& b, const V
   TetrahedronIntegrals t;
   t.volume = det / 6.0;
   t.first_moment = t.volume * sum / 4.0;
-  t.second_moment = det / 120.0 * (a * a.transpose() + b * b.transpose() + c * c.transpose() +
-                                   sum * sum.transpose());
+  t.second_moment =
+      det / 120.0 *
+      (a * a.transpose() + b * b.transpose() + c * c.transpose() + sum * sum.transpose());
   return t;
 }
 

@@ -1,8 +1,8 @@
 #include "fignet/geometry/mesh.h"
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
 #include <map>
 #include <utility>
 #include <vector>
@@ -47,8 +47,7 @@ void check_indices(const std::string& name, const Triangles& faces, Eigen::Index
 // Removes (or rejects) faces whose area is negligible relative to the mesh's size.
 Triangles filter_degenerate(const std::string& name, const Points& vertices, const Triangles& faces,
                             const MeshOptions& options, int* dropped) {
-  const double diagonal =
-      (vertices.colwise().maxCoeff() - vertices.colwise().minCoeff()).norm();
+  const double diagonal = (vertices.colwise().maxCoeff() - vertices.colwise().minCoeff()).norm();
   const double min_area = options.degenerate_area_ratio * diagonal * diagonal;
   std::vector<Eigen::Index> kept;
   kept.reserve(faces.rows());
@@ -59,10 +58,10 @@ Triangles filter_degenerate(const std::string& name, const Points& vertices, con
     if (area > min_area) {
       kept.push_back(f);
     } else if (options.degenerate_faces == DegenerateFaces::kReject) {
-      throw MeshError(fmt::format(
-          "mesh '{}': face {} is degenerate (area {:.3g} <= {:.3g}); pass "
-          "DegenerateFaces::kDrop to remove such faces",
-          name, f, area, min_area));
+      throw MeshError(
+          fmt::format("mesh '{}': face {} is degenerate (area {:.3g} <= {:.3g}); pass "
+                      "DegenerateFaces::kDrop to remove such faces",
+                      name, f, area, min_area));
     }
   }
   *dropped = static_cast<int>(faces.rows() - static_cast<Eigen::Index>(kept.size()));

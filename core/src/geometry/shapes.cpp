@@ -93,8 +93,8 @@ TriangleMesh revolve(std::string name, const std::vector<Eigen::Vector2d>& profi
     std::vector<int> ring;
     for (int i = 0; i < segments; ++i) {
       const double angle = 2.0 * kPi * i / segments;
-      ring.push_back(b.add_vertex(
-          Vec3(point.x() * std::cos(angle), point.x() * std::sin(angle), point.y())));
+      ring.push_back(
+          b.add_vertex(Vec3(point.x() * std::cos(angle), point.x() * std::sin(angle), point.y())));
     }
     rings.push_back(std::move(ring));
   }
@@ -140,8 +140,8 @@ TriangleMesh voxel_surface(std::string name, int n, double half_extent, int subd
     const auto [it, inserted] = index.try_emplace({x, y, z}, -1);
     if (inserted) {
       const double step = 2.0 * half_extent / lattice;
-      it->second = b.add_vertex(Vec3(-half_extent + x * step, -half_extent + y * step,
-                                     -half_extent + z * step));
+      it->second = b.add_vertex(
+          Vec3(-half_extent + x * step, -half_extent + y * step, -half_extent + z * step));
     }
     return it->second;
   };
@@ -213,10 +213,10 @@ TriangleMesh make_sphere(double radius, int rings, int segments) {
 TriangleMesh make_cylinder(double radius, double half_height, int segments) {
   require(radius > 0 && half_height > 0, "cylinder", "radius and half height must be positive");
   require(segments >= 3, "cylinder", "needs >= 3 segments");
-  return revolve("cylinder",
-                 {{0.0, -half_height}, {radius, -half_height}, {radius, half_height},
-                  {0.0, half_height}},
-                 segments);
+  return revolve(
+      "cylinder",
+      {{0.0, -half_height}, {radius, -half_height}, {radius, half_height}, {0.0, half_height}},
+      segments);
 }
 
 TriangleMesh make_cone(double radius, double height, int segments) {

@@ -1,8 +1,8 @@
 #include "fignet/geometry/triangle_distance.h"
 
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <utility>
 
 namespace fignet {

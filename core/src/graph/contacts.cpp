@@ -50,9 +50,8 @@ void ContactFinder::find_candidate_pairs(double radius, std::vector<ObjectPair>&
   const auto n = static_cast<std::int32_t>(slots_.size());
   sweep_.resize(n);
   for (std::int32_t i = 0; i < n; ++i) sweep_[i] = i;
-  std::sort(sweep_.begin(), sweep_.end(), [&](std::int32_t a, std::int32_t b) {
-    return bounds(a).min.x() < bounds(b).min.x();
-  });
+  std::sort(sweep_.begin(), sweep_.end(),
+            [&](std::int32_t a, std::int32_t b) { return bounds(a).min.x() < bounds(b).min.x(); });
   const double radius2 = radius * radius;
   for (std::int32_t i = 0; i < n; ++i) {
     const Aabb& a = bounds(sweep_[i]);
@@ -64,8 +63,9 @@ void ContactFinder::find_candidate_pairs(double radius, std::vector<ObjectPair>&
     }
   }
   // A deterministic order, independent of the sort's tie-breaking.
-  std::sort(out.begin(), out.end(),
-            [](const ObjectPair& x, const ObjectPair& y) { return std::tie(x.a, x.b) < std::tie(y.a, y.b); });
+  std::sort(out.begin(), out.end(), [](const ObjectPair& x, const ObjectPair& y) {
+    return std::tie(x.a, x.b) < std::tie(y.a, y.b);
+  });
 }
 
 void ContactFinder::find_face_pairs(std::span<const ObjectPair> candidates, double radius,

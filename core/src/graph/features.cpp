@@ -79,7 +79,8 @@ void put_edge(EdgeSet& out, int sender, int receiver, const Vec3& d, const Vec3&
 
 void append_mesh_edges(const SceneObject& object, int first, EdgeSet& out) {
   const int v = object.mesh->num_vertices();
-  const auto current = object.positions.middleRows(static_cast<Eigen::Index>(object.num_steps() - 1) * v, v);
+  const auto current =
+      object.positions.middleRows(static_cast<Eigen::Index>(object.num_steps() - 1) * v, v);
   const Points& rest = object.mesh->vertices();
   const EdgeList& edges = object.mesh->edges();
   for (Eigen::Index e = 0; e < edges.rows(); ++e) {
@@ -94,7 +95,8 @@ void append_mesh_edges(const SceneObject& object, int first, EdgeSet& out) {
 void append_object_mesh_edges(const SceneObject& object, int object_index, int first,
                               EdgeSet& object_to_mesh, EdgeSet& mesh_to_object) {
   const int v = object.mesh->num_vertices();
-  const auto current = object.positions.middleRows(static_cast<Eigen::Index>(object.num_steps() - 1) * v, v);
+  const auto current =
+      object.positions.middleRows(static_cast<Eigen::Index>(object.num_steps() - 1) * v, v);
   const Vec3 center = object.centers.bottomRows(1).transpose();
   // Rest vertices are in the centre-of-mass frame, so the object node rests at the origin.
   for (int i = 0; i < v; ++i) {
@@ -110,7 +112,7 @@ namespace {
 // A face's three nodes sorted by distance to its closest point; exact ties are broken by the
 // spanning vector itself, so the order depends on geometry only, never on the input order.
 struct SortedFace {
-  std::array<int, 3> nodes;  // local vertex indices, sorted
+  std::array<int, 3> nodes;   // local vertex indices, sorted
   std::array<Vec3, 3> spans;  // x_j − p
 };
 

@@ -56,7 +56,8 @@ void GraphBuilder::validate_scene(const Scene& scene, int scene_index) const {
                        object.next_positions.rows(), v));
     }
     if (!object.positions.allFinite() || !object.centers.allFinite() ||
-        (object.kinematic && (!object.next_positions.allFinite() || !object.next_center.allFinite()))) {
+        (object.kinematic &&
+         (!object.next_positions.allFinite() || !object.next_center.allFinite()))) {
       fail("has a non-finite position");
     }
   }
@@ -155,8 +156,9 @@ void GraphBuilder::build_scenes(std::span<const Scene> scenes,
       for (const ObjectPair& pair : *candidates) {
         const int n = static_cast<int>(objects_.size());
         if (pair.a < 0 || pair.b < 0 || pair.a >= n || pair.b >= n || pair.a == pair.b) {
-          throw ConfigError(fmt::format("candidate pair ({}, {}) is not a pair of the scene's {} objects",
-                                        pair.a, pair.b, n));
+          throw ConfigError(
+              fmt::format("candidate pair ({}, {}) is not a pair of the scene's {} objects", pair.a,
+                          pair.b, n));
         }
         if (posed_[pair.a].kinematic && posed_[pair.b].kinematic) continue;
         pairs_.push_back({std::min(pair.a, pair.b), std::max(pair.a, pair.b)});

@@ -50,11 +50,12 @@ RestingLattice make_resting_lattice(const RestingLatticeOptions& options) {
     SceneObject object;
     object.mesh = cache[{options.shapes[pick_shape(rng)], options.scales[pick_scale(rng)]}];
     Pose pose;
-    pose.orientation = Eigen::Quaterniond(Eigen::Vector4d(uniform(rng), uniform(rng), uniform(rng),
-                                                          uniform(rng)))
-                           .normalized();
+    pose.orientation =
+        Eigen::Quaterniond(Eigen::Vector4d(uniform(rng), uniform(rng), uniform(rng), uniform(rng)))
+            .normalized();
     // Lowest vertex half a gap above the floor, centred on its lattice cell.
-    const Points rotated = object.mesh->vertices() * pose.orientation.toRotationMatrix().transpose();
+    const Points rotated =
+        object.mesh->vertices() * pose.orientation.toRotationMatrix().transpose();
     const double lowest = rotated.col(2).minCoeff();
     pose.position = Vec3((i % side - 0.5 * (side - 1)) * spacing,
                          (i / side - 0.5 * (side - 1)) * spacing, options.gap / 2 - lowest);
@@ -67,8 +68,9 @@ RestingLattice make_resting_lattice(const RestingLatticeOptions& options) {
       history[k].position = pose.position + t * velocity;
       const Vec3 angle = t * spin;
       history[k].orientation =
-          (angle.norm() > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle.norm(), angle.normalized()))
-                            : Eigen::Quaterniond::Identity()) *
+          (angle.norm() > 0
+               ? Eigen::Quaterniond(Eigen::AngleAxisd(angle.norm(), angle.normalized()))
+               : Eigen::Quaterniond::Identity()) *
           pose.orientation;
     }
     set_pose_history(object, history);

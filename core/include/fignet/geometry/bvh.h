@@ -78,8 +78,8 @@ void Bvh::for_each_pair_within(const Bvh& other, double margin, Visit&& visit) c
       continue;
     }
     // Descend the larger box (or the only inner node) so both trees shrink together.
-    const bool descend_a =
-        !a.is_leaf() && (b.is_leaf() || a.box.extent().squaredNorm() >= b.box.extent().squaredNorm());
+    const bool descend_a = !a.is_leaf() && (b.is_leaf() || a.box.extent().squaredNorm() >=
+                                                               b.box.extent().squaredNorm());
     const std::int32_t a_index = stack[top][0], b_index = stack[top][1];
     if (descend_a) {
       stack[top][0] = a.first, stack[top][1] = b_index, ++top;

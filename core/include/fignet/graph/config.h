@@ -17,9 +17,9 @@ enum class FloorModel {
 };
 
 struct GraphConfig {
-  double collision_radius = 0.1;   // d_c in metres: faces of different objects closer than this
-  int history = 2;                 // h: velocities per node feature (h + 1 positions are needed)
-  bool object_nodes = true;        // false gives FIGNet-NoObjectNode
+  double collision_radius = 0.1;  // d_c in metres: faces of different objects closer than this
+  int history = 2;                // h: velocities per node feature (h + 1 positions are needed)
+  bool object_nodes = true;       // false gives FIGNet-NoObjectNode
   CollisionEdges collisions = CollisionEdges::kFaceFace;
   FloorModel floor = FloorModel::kMesh;
   double floor_half_extent = 40.0;  // the floor spans [-e, e]² (Kubric's dome bounds)

@@ -66,8 +66,8 @@ class ContactFinder {
     Bvh nodes;
   };
   std::vector<Slot> slots_;
-  std::vector<Aabb> boxes_;            // scratch: primitive boxes of one object
-  std::vector<std::int32_t> sweep_;    // scratch: objects sorted by min x
+  std::vector<Aabb> boxes_;          // scratch: primitive boxes of one object
+  std::vector<std::int32_t> sweep_;  // scratch: objects sorted by min x
 };
 
 }  // namespace fignet

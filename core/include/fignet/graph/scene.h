@@ -37,7 +37,9 @@ struct SceneObject {
   Points next_positions;
   Vec3 next_center = Vec3::Zero();
 
-  int num_steps() const { return mesh ? static_cast<int>(positions.rows() / mesh->num_vertices()) : 0; }
+  int num_steps() const {
+    return mesh ? static_cast<int>(positions.rows() / mesh->num_vertices()) : 0;
+  }
   // Positions of all nodes at history step k (0 = oldest, h = current).
   auto positions_at(int k) const {
     return positions.middleRows(static_cast<Eigen::Index>(k) * mesh->num_vertices(),
@@ -51,7 +53,7 @@ void set_pose_history(SceneObject& object, std::span<const Pose> poses,
                       const std::optional<Pose>& next_pose = std::nullopt);
 
 struct Floor {
-  double height = 0.0;  // the floor is the plane z = height, normal +z
+  double height = 0.0;                         // the floor is the plane z = height, normal +z
   StaticProperties properties{0.0, 0.3, 0.5};  // Kubric's floor: friction 0.3, restitution 0.5
 };
 

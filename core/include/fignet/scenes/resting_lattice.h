@@ -16,11 +16,11 @@ namespace fignet {
 struct RestingLatticeOptions {
   int objects = 6;
   std::uint64_t seed = 0;
-  int history = 2;                                           // velocities (h + 1 poses)
+  int history = 2;                                                   // velocities (h + 1 poses)
   std::vector<std::string> shapes = {"cube", "cylinder", "sphere"};  // MOVi-A
-  std::vector<double> scales = {0.35, 0.7};                  // shape scale factors
-  double gap = 0.05;       // clearance between neighbours' bounding spheres, metres
-  double speed = 0.5;      // magnitude of the random drift, m/s
+  std::vector<double> scales = {0.35, 0.7};                          // shape scale factors
+  double gap = 0.05;   // clearance between neighbours' bounding spheres, metres
+  double speed = 0.5;  // magnitude of the random drift, m/s
   double time_step = 1.0 / 48.0;
 };
 
