@@ -48,23 +48,29 @@ std::set<Key> brute_force_faces(const std::vector<PosedMesh>& posed, double radi
   return pairs;
 }
 
+// Runs the finder's own sweep and face query at `radius`; checks each pair's consistency.
+std::set<Key> query_face_pairs(ContactFinder& finder, double radius) {
+  std::vector<ObjectPair> candidates;
+  std::vector<FacePair> found;
+  finder.find_candidate_pairs(radius, candidates);
+  finder.find_face_pairs(candidates, radius, found);
+  std::set<Key> keys;
+  for (const FacePair& p : found) {
+    EXPECT_TRUE(keys.insert({p.object_a, p.face_a, p.object_b, p.face_b}).second);
+    EXPECT_LE(p.distance, radius);
+    EXPECT_NEAR((p.point_a - p.point_b).norm(), p.distance, 1e-12);
+  }
+  return keys;
+}
+
 TEST(ContactFinder, FacePairsEqualAllPairsBruteForce) {
   for (unsigned seed = 1; seed <= 6; ++seed) {
     const auto fixture = testing::make_random_scene(seed, 8, 0.8);
     const auto posed = posed_current(fixture.scene, 2);
     ContactFinder finder;
     finder.update(posed, false);
-    std::vector<ObjectPair> candidates;
-    std::vector<FacePair> found;
     for (double radius : {0.0, 0.05, 0.1, 0.25}) {
-      finder.find_candidate_pairs(radius, candidates);
-      finder.find_face_pairs(candidates, radius, found);
-      std::set<Key> keys;
-      for (const FacePair& p : found) {
-        EXPECT_TRUE(keys.insert({p.object_a, p.face_a, p.object_b, p.face_b}).second);
-        EXPECT_LE(p.distance, radius);
-        EXPECT_NEAR((p.point_a - p.point_b).norm(), p.distance, 1e-12);
-      }
+      const std::set<Key> keys = query_face_pairs(finder, radius);
       const auto expected = brute_force_faces(posed, radius);
       EXPECT_EQ(keys, expected) << "seed " << seed << ", radius " << radius;
       if (radius == 0.1) {
@@ -79,18 +85,13 @@ TEST(ContactFinder, RefitOnMovedObjectsMatchesBruteForce) {
   ContactFinder finder;
   finder.update(posed_current(fixture.scene, 2), false);
   // Move every object by a rigid shift; the second update refits instead of rebuilding.
-  for (auto& object : fixture.scene.objects)
+  for (auto& object : fixture.scene.objects) {
     object.positions.rowwise() +=
         Eigen::RowVector3d(0.1, -0.2, 0.05) * (object.properties.mass + 1);
+  }
   const auto posed = posed_current(fixture.scene, 2);
   finder.update(posed, false);
-  std::vector<ObjectPair> candidates;
-  std::vector<FacePair> found;
-  finder.find_candidate_pairs(0.1, candidates);
-  finder.find_face_pairs(candidates, 0.1, found);
-  std::set<Key> keys;
-  for (const FacePair& p : found) keys.insert({p.object_a, p.face_a, p.object_b, p.face_b});
-  EXPECT_EQ(keys, brute_force_faces(posed, 0.1));
+  EXPECT_EQ(query_face_pairs(finder, 0.1), brute_force_faces(posed, 0.1));
 }
 
 TEST(ContactFinder, NodePairsEqualAllPairsBruteForce) {
