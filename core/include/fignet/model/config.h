@@ -1,0 +1,35 @@
+// Every tunable of a FIGNet model — graph, network size, training noise, normalisation, and the
+// physical setting it was trained in — in one struct, saved in and checked against model files.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fignet/geometry/types.h"
+#include "fignet/graph/config.h"
+
+namespace fignet {
+
+struct ModelConfig {
+  std::string preset = "paper";
+  GraphConfig graph;
+  int latent_size = 128;           // L: hidden and output width of every MLP (seed C.2)
+  int message_passing_steps = 10;  // M, unshared weights (seed C.1.2)
+  double noise_std = 3e-4;         // random-walk noise at the last input position, metres
+  std::int64_t normalizer_max_accumulations = 1'000'000;  // statistics freeze afterwards
+  double time_step = 1.0 / 48.0;   // seconds between the frames the model was trained on
+  Vec3 gravity = Vec3(0, 0, -10);  // the training data's gravity
+  std::uint64_t seed = 0;          // parameter initialisation
+
+  // "paper": L = 128, M = 10, d_c = 0.1 m (seed C.2). "small": L = 64, M = 5, about 10x fewer
+  // FLOPs, for quick training and fast inference. Throws ConfigError for another name.
+  static ModelConfig preset_named(std::string_view name);
+  static const std::vector<std::string>& preset_names();
+
+  // Throws ConfigError naming the first invalid field.
+  void validate() const;
+};
+
+}  // namespace fignet

@@ -1,0 +1,42 @@
+// Adam over a flat parameter array, with the seed's exponential learning-rate decay
+// (1e-3 to 1e-4 over the configured number of steps, then held).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace fignet {
+
+struct AdamConfig {
+  float learning_rate_start = 1e-3f;
+  float learning_rate_end = 1e-4f;
+  std::int64_t decay_steps = 1'000'000;
+  float beta1 = 0.9f, beta2 = 0.999f, epsilon = 1e-8f;
+};
+
+class Adam {
+ public:
+  Adam() = default;
+  Adam(size_t num_parameters, const AdamConfig& config);
+
+  // One update of `params` from `grads`; increments step().
+  void update(std::vector<float>& params, const std::vector<float>& grads);
+  float learning_rate() const;  // the rate the next update() will use
+  std::int64_t step() const { return step_; }
+  const AdamConfig& config() const { return config_; }
+
+  // State for checkpoints: the first and second moments and the step count.
+  std::vector<float>& first_moment() { return m_; }
+  std::vector<float>& second_moment() { return v_; }
+  const std::vector<float>& first_moment() const { return m_; }
+  const std::vector<float>& second_moment() const { return v_; }
+  void set_step(std::int64_t step) { step_ = step; }
+
+ private:
+  AdamConfig config_;
+  std::vector<float> m_, v_;
+  std::int64_t step_ = 0;
+};
+
+}  // namespace fignet

@@ -1,0 +1,48 @@
+#include "fignet/model/config.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <cmath>
+
+#include "fignet/error.h"
+
+namespace fignet {
+
+const std::vector<std::string>& ModelConfig::preset_names() {
+  static const std::vector<std::string> names = {"paper", "small"};
+  return names;
+}
+
+ModelConfig ModelConfig::preset_named(std::string_view name) {
+  ModelConfig config;
+  config.preset = std::string(name);
+  if (name == "paper") return config;
+  if (name == "small") {
+    config.latent_size = 64;
+    config.message_passing_steps = 5;
+    return config;
+  }
+  throw ConfigError(fmt::format("unknown model preset '{}'; known presets: {}", name,
+                                fmt::join(preset_names(), ", ")));
+}
+
+void ModelConfig::validate() const {
+  graph.validate();
+  auto fail = [](const char* field, auto value, const char* rule) {
+    throw ConfigError(fmt::format("model config: {} = {} ({})", field, value, rule));
+  };
+  if (latent_size < 1 || latent_size > 4096) fail("latent_size", latent_size, "must be in 1..4096");
+  if (message_passing_steps < 0 || message_passing_steps > 64) {
+    fail("message_passing_steps", message_passing_steps, "must be in 0..64");
+  }
+  if (!(noise_std >= 0.0) || !std::isfinite(noise_std))
+    fail("noise_std", noise_std, "must be >= 0");
+  if (normalizer_max_accumulations < 1) {
+    fail("normalizer_max_accumulations", normalizer_max_accumulations, "must be >= 1");
+  }
+  if (!(time_step > 0.0) || !std::isfinite(time_step)) fail("time_step", time_step, "must be > 0");
+  if (!gravity.allFinite()) fail("gravity", "non-finite", "must be finite");
+}
+
+}  // namespace fignet

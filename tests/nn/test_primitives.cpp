@@ -1,0 +1,149 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "fignet/nn/adam.h"
+#include "fignet/nn/mlp.h"
+#include "fignet/nn/ops.h"
+#include "gradient_check.h"
+
+namespace fignet {
+namespace {
+
+RowMatrixXf random_matrix(std::mt19937& rng, int rows, int cols) {
+  std::normal_distribution<float> n;
+  RowMatrixXf m(rows, cols);
+  for (int i = 0; i < m.size(); ++i) m.data()[i] = n(rng);
+  return m;
+}
+
+std::vector<std::int32_t> random_index(std::mt19937& rng, int count, int range) {
+  std::uniform_int_distribution<int> u(0, range - 1);
+  std::vector<std::int32_t> index(count);
+  for (auto& i : index) i = u(rng);
+  return index;
+}
+
+TEST(Ops, ScatterAddIsTheAdjointOfGatherAdd) {
+  std::mt19937 rng(1);
+  const RowMatrixXf nodes = random_matrix(rng, 7, 5), edges = random_matrix(rng, 20, 5);
+  const auto index = random_index(rng, 20, 7);
+  const IndexSpan span{index.data(), 20};
+  RowMatrixXf gathered = RowMatrixXf::Zero(20, 5), scattered = RowMatrixXf::Zero(7, 5);
+  gather_add(nodes, span, gathered);
+  scatter_add(edges, span, scattered);
+  // <gather(x), y> = <x, scatter(y)>
+  EXPECT_NEAR(gathered.cwiseProduct(edges).sum(), nodes.cwiseProduct(scattered).sum(), 1e-4);
+  // Strided spans read every third entry.
+  const IndexSpan second{index.data(), 6, 3, 1};
+  EXPECT_EQ(second[2], index[7]);
+}
+
+TEST(Ops, GatheredProductEqualsGatherThenMultiply) {
+  std::mt19937 rng(2);
+  const RowMatrixXf x = random_matrix(rng, 9, 4), w = random_matrix(rng, 4, 6);
+  const auto index = random_index(rng, 30, 9);
+  RowMatrixXf z = RowMatrixXf::Zero(30, 6), gathered = RowMatrixXf::Zero(30, 4);
+  Buffer scratch;
+  add_gathered_product(x, w, {index.data(), 30}, z, scratch);
+  gather_add(x, {index.data(), 30}, gathered);
+  EXPECT_TRUE(z.isApprox(gathered * w, 1e-5f));
+  // Its adjoint against the explicit form: dx = scatter(dz·wᵀ), dw = gatheredᵀ·dz.
+  const RowMatrixXf dz = random_matrix(rng, 30, 6);
+  RowMatrixXf dw = RowMatrixXf::Zero(4, 6), dx = RowMatrixXf::Zero(9, 4);
+  MatrixRef dx_ref = dx;
+  backprop_gathered_product(x, w, {index.data(), 30}, dz, dw, &dx_ref, scratch);
+  RowMatrixXf expected_dx = RowMatrixXf::Zero(9, 4);
+  scatter_add(dz * w.transpose(), {index.data(), 30}, expected_dx);
+  EXPECT_TRUE(dw.isApprox(gathered.transpose() * dz, 1e-4f));
+  EXPECT_TRUE(dx.isApprox(expected_dx, 1e-4f));
+}
+
+class MlpGradient : public ::testing::TestWithParam<bool> {};
+
+TEST_P(MlpGradient, MatchesFiniteDifferences) {
+  const bool layer_norm = GetParam();
+  ParameterLayout layout;
+  const Mlp mlp(layout, "mlp", {3, 4}, 6, 5, layer_norm);
+  std::vector<float> params;
+  layout.initialize(params, 3);
+  std::mt19937 rng(4);
+  const RowMatrixXf a = random_matrix(rng, 8, 3), b = random_matrix(rng, 8, 4);
+  const RowMatrixXf weights = random_matrix(rng, 8, 5);  // loss = Σ out ⊙ weights
+  Buffer first;
+  MlpCache cache;
+  RowMatrixXf out(8, 5);
+  auto run = [&](const std::vector<float>& p) {
+    MatrixView z = first.view(8, 6);
+    z.noalias() = a * mlp.first_weight(p.data(), 0);
+    z.noalias() += b * mlp.first_weight(p.data(), 1);
+    mlp.forward(p.data(), z, cache, out);
+    return out.cast<double>().cwiseProduct(weights.cast<double>()).sum();
+  };
+  run(params);
+  std::vector<float> grads(layout.size(), 0.0f);
+  mlp.backward(params.data(), grads.data(), weights, cache);
+  MatrixView dw_a = mlp.first_weight(grads.data(), 0), dw_b = mlp.first_weight(grads.data(), 1);
+  dw_a.noalias() += a.transpose() * cache.d_first.get();
+  dw_b.noalias() += b.transpose() * cache.d_first.get();
+  EXPECT_EQ(testing::check_gradients(layout, params, grads, run, 40), 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(WithAndWithoutLayerNorm, MlpGradient, ::testing::Bool());
+
+TEST(Mlp, LayerNormOutputHasZeroMeanUnitVariancePerRow) {
+  ParameterLayout layout;
+  const Mlp mlp(layout, "mlp", {4}, 16, 32, true);
+  std::vector<float> params;
+  layout.initialize(params, 5);
+  std::mt19937 rng(6);
+  const RowMatrixXf x = random_matrix(rng, 10, 4);
+  Buffer first;
+  MlpCache cache;
+  RowMatrixXf out(10, 32);
+  mlp.forward_dense(params.data(), x, first, cache, out);
+  for (int r = 0; r < 10; ++r) {
+    EXPECT_NEAR(out.row(r).mean(), 0.0f, 1e-5f);
+    EXPECT_NEAR((out.row(r).array() - out.row(r).mean()).square().mean(), 1.0f, 5e-3f);  // ε = 1e-5
+  }
+}
+
+TEST(Parameters, InitialisationIsSeededAndScaledByFanIn) {
+  ParameterLayout layout;
+  const size_t w = layout.add("w", 400, 300, Init::kFanIn);
+  const size_t b = layout.add("b", 1, 300, Init::kZeros);
+  const size_t s = layout.add("s", 1, 300, Init::kOnes);
+  std::vector<float> p1, p2, p3;
+  layout.initialize(p1, 1);
+  layout.initialize(p2, 1);
+  layout.initialize(p3, 2);
+  EXPECT_EQ(p1, p2);
+  EXPECT_NE(p1, p3);
+  const auto weights = tensor(p1.data(), w, 400, 300);
+  // Truncated at ±2σ: the standard deviation is 0.88σ, σ = 1/sqrt(400).
+  const float std = std::sqrt(weights.array().square().mean());
+  EXPECT_NEAR(std, 0.88f / 20.0f, 0.002f);
+  EXPECT_LE(weights.cwiseAbs().maxCoeff(), 2.0f / 20.0f);
+  EXPECT_EQ(tensor(p1.data(), b, 1, 300).cwiseAbs().maxCoeff(), 0.0f);
+  EXPECT_EQ(tensor(p1.data(), s, 1, 300).minCoeff(), 1.0f);
+}
+
+TEST(Adam, DecaysTheLearningRateExponentiallyAndMinimisesAQuadratic) {
+  Adam adam(2, {.learning_rate_start = 1e-1f, .learning_rate_end = 1e-2f, .decay_steps = 100});
+  EXPECT_FLOAT_EQ(adam.learning_rate(), 1e-1f);
+  std::vector<float> x = {3.0f, -2.0f}, g(2);
+  for (int i = 0; i < 50; ++i) {
+    g = {2 * x[0], 2 * x[1]};
+    adam.update(x, g);
+  }
+  EXPECT_NEAR(adam.learning_rate(), 1e-1f * std::pow(0.1f, 0.5f), 1e-6f);  // halfway: 10^-1.5
+  for (int i = 0; i < 450; ++i) {
+    g = {2 * x[0], 2 * x[1]};
+    adam.update(x, g);
+  }
+  EXPECT_FLOAT_EQ(adam.learning_rate(), 1e-2f);  // held after decay_steps
+  EXPECT_LT(std::abs(x[0]) + std::abs(x[1]), 0.05f);
+}
+
+}  // namespace
+}  // namespace fignet
