@@ -1,6 +1,7 @@
 # Every third-party package comes from Debian bookworm (scripts/install-deps.sh installs them).
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)
 find_package(fmt REQUIRED)
+find_package(OpenMP REQUIRED)  # Eigen's GEMM threads
 find_package(CLI11 REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 find_package(HDF5 REQUIRED COMPONENTS CXX)

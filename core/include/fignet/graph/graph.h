@@ -33,7 +33,7 @@ class FeatureMatrix {
   Eigen::Map<RowMatrixXf> matrix() { return {data_.data(), rows_, cols_}; }
 
  private:
-  std::vector<float> data_;
+  std::vector<float, Eigen::aligned_allocator<float>> data_;
   int rows_ = 0, cols_ = 0;
 };
 

@@ -14,6 +14,11 @@ using ConstMatrixView = Eigen::Map<const RowMatrixXf>;
 using MatrixRef = Eigen::Ref<RowMatrixXf, 0, Eigen::OuterStride<>>;
 using ConstMatrixRef = Eigen::Ref<const RowMatrixXf, 0, Eigen::OuterStride<>>;
 
+// Storage aligned for SIMD: Eigen's vectorised reductions peel scalars until the data is aligned,
+// so an address-dependent alignment would change the summation order and break bit-exact
+// determinism between runs and between two trainers in one process.
+using AlignedFloats = std::vector<float, Eigen::aligned_allocator<float>>;
+
 class Buffer {
  public:
   // A rows x cols view of the buffer (contents unspecified).
@@ -33,7 +38,7 @@ class Buffer {
   ConstMatrixView cget() const { return get(); }
 
  private:
-  std::vector<float> data_;
+  AlignedFloats data_;
   Eigen::Index rows_ = 0, cols_ = 0;
 };
 

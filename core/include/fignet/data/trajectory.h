@@ -1,0 +1,37 @@
+// A recorded rigid-body trajectory: rest meshes, static properties, kinematic flags and one pose
+// per object per frame. What the data generator writes, training samples from, and rollouts are
+// compared against.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fignet/graph/scene.h"
+
+namespace fignet {
+
+struct TrajectoryObject {
+  std::shared_ptr<const TriangleMesh> mesh;  // rest mesh in the centre-of-mass frame
+  StaticProperties properties;
+  bool kinematic = false;
+  std::vector<Pose> poses;  // one per frame
+};
+
+struct Trajectory {
+  std::vector<TrajectoryObject> objects;
+  std::optional<Floor> floor;
+  double time_step = 1.0 / 48.0;  // seconds between frames
+  Vec3 gravity = Vec3(0, 0, -10);
+
+  int num_frames() const { return objects.empty() ? 0 : static_cast<int>(objects[0].poses.size()); }
+  // Throws ConfigError when objects disagree on frame count or a pose is not finite.
+  void validate() const;
+};
+
+// Fills `scene` with frames t-h … t of the trajectory (kinematic objects also get frame t+1),
+// reusing its buffers. Requires h <= t and, for kinematic objects, t + 1 < num_frames().
+void scene_at_frame(const Trajectory& trajectory, int t, int history, Scene& scene);
+
+}  // namespace fignet

@@ -1,0 +1,55 @@
+// Anything that predicts per-node accelerations for a scene: a FIGNet model, or a stand-in (exact
+// gravity, constant velocity) for baselines and tests. Rollouts and the Bullet world use this
+// interface, so they run the same code path whatever predicts.
+#pragma once
+
+#include <memory>
+
+#include "fignet/graph/graph_builder.h"
+#include "fignet/model/model.h"
+
+namespace fignet {
+
+class AccelerationPredictor {
+ public:
+  virtual ~AccelerationPredictor() = default;
+  // Positions of how many past frames the predictor needs besides the current one.
+  virtual int history() const = 0;
+  // One row per node of scene.objects, in order: the finite-difference acceleration
+  // x^{t+1} − 2x^t + x^{t−1} in metres (rows of kinematic objects are ignored by callers).
+  virtual void predict(const Scene& scene, Points& accelerations) = 0;
+};
+
+// Runs a FIGNet model: builds the graph, runs the network, un-normalises. One per thread.
+class ModelPredictor : public AccelerationPredictor {
+ public:
+  explicit ModelPredictor(std::shared_ptr<const Model> model);
+  int history() const override { return model_->config().graph.history; }
+  void predict(const Scene& scene, Points& accelerations) override;
+  // The graph of the last prediction (for edge counts and debug drawing).
+  const Graph& last_graph() const { return graph_; }
+  const GraphBuilder& builder() const { return builder_; }
+
+ private:
+  std::shared_ptr<const Model> model_;
+  GraphBuilder builder_;
+  Graph graph_;
+  NetworkWorkspace workspace_;
+  RowMatrixXf denormalized_;
+};
+
+// Exact free fall: every node accelerates by gravity·dt² (the ballistic baseline without
+// collisions; with h >= 1 the history supplies the velocity).
+class GravityPredictor : public AccelerationPredictor {
+ public:
+  GravityPredictor(const Vec3& gravity, double time_step, int history = 2)
+      : step_acceleration_(gravity * time_step * time_step), history_(history) {}
+  int history() const override { return history_; }
+  void predict(const Scene& scene, Points& accelerations) override;
+
+ private:
+  Vec3 step_acceleration_;
+  int history_;
+};
+
+}  // namespace fignet

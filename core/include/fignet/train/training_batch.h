@@ -1,0 +1,33 @@
+// One training batch: scenes at random frames of the training trajectories, random-walk noise on
+// their input histories (GNS), and the noise-corrected target accelerations of their nodes.
+#pragma once
+
+#include <random>
+#include <vector>
+
+#include "fignet/data/trajectory.h"
+#include "fignet/graph/graph.h"
+
+namespace fignet {
+
+struct SampleRef {
+  int trajectory = 0, frame = 0;  // predict frame + 1 from frames frame − h … frame
+};
+
+// Every (trajectory, frame) that has h past frames and a next frame.
+std::vector<SampleRef> enumerate_samples(const std::vector<Trajectory>& data, int history);
+
+// Fills `scene` for the sample and adds random-walk noise to the positions of its dynamic nodes:
+// per-step velocity noise of std noise_std/sqrt(h), summed over the history, so the current
+// position's noise has std noise_std and the oldest none. Writes each node's target
+// x^{t+1} − 2x̃^t + x̃^{t−1} + n^t, which asks the model to undo the velocity noise (rows follow
+// scene.objects; kinematic rows are zero).
+void make_noisy_sample(const Trajectory& trajectory, int frame, int history, double noise_std,
+                       std::mt19937_64& rng, Scene& scene, Points& targets);
+
+// Stacks per-scene targets into graph row order (each scene's floor nodes get zero rows) and
+// marks which rows count in the loss (dynamic nodes).
+void gather_targets(const Graph& graph, const std::vector<Points>& scene_targets,
+                    RowMatrixXf& targets, std::vector<std::uint8_t>& in_loss);
+
+}  // namespace fignet

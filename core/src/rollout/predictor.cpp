@@ -1,0 +1,34 @@
+#include "fignet/rollout/predictor.h"
+
+namespace fignet {
+
+namespace {
+
+Eigen::Index count_nodes(const Scene& scene) {
+  Eigen::Index n = 0;
+  for (const SceneObject& object : scene.objects) n += object.mesh->num_vertices();
+  return n;
+}
+
+}  // namespace
+
+ModelPredictor::ModelPredictor(std::shared_ptr<const Model> model)
+    : model_(std::move(model)), builder_(model_->config().graph) {}
+
+void ModelPredictor::predict(const Scene& scene, Points& accelerations) {
+  builder_.build(scene, graph_);
+  const ConstMatrixView normalized = model_->network().forward(
+      model_->parameters().data(), model_->normalizers(), graph_, workspace_, false);
+  // The scene's objects come first in the graph; a mesh floor's nodes follow and are dropped.
+  const Eigen::Index n = count_nodes(scene);
+  denormalized_.resize(n, 3);
+  model_->normalizers().target.denormalize(normalized.topRows(n), denormalized_);
+  accelerations = denormalized_.cast<double>();
+}
+
+void GravityPredictor::predict(const Scene& scene, Points& accelerations) {
+  accelerations.resize(count_nodes(scene), 3);
+  accelerations.rowwise() = step_acceleration_.transpose();
+}
+
+}  // namespace fignet

@@ -1,0 +1,63 @@
+#include "fignet/train/training_batch.h"
+
+#include <cmath>
+
+namespace fignet {
+
+std::vector<SampleRef> enumerate_samples(const std::vector<Trajectory>& data, int history) {
+  std::vector<SampleRef> samples;
+  for (size_t i = 0; i < data.size(); ++i) {
+    for (int t = history; t + 1 < data[i].num_frames(); ++t) samples.push_back({int(i), t});
+  }
+  return samples;
+}
+
+void make_noisy_sample(const Trajectory& trajectory, int frame, int history, double noise_std,
+                       std::mt19937_64& rng, Scene& scene, Points& targets) {
+  scene_at_frame(trajectory, frame, history, scene);
+  Eigen::Index rows = 0;
+  for (const SceneObject& object : scene.objects) rows += object.mesh->num_vertices();
+  targets.setZero(rows, 3);
+  std::normal_distribution<double> normal(0.0, noise_std / std::sqrt(static_cast<double>(history)));
+  Eigen::Index row = 0;
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    SceneObject& object = scene.objects[o];
+    const Eigen::Index v = object.mesh->num_vertices();
+    if (object.kinematic) {
+      row += v;
+      continue;
+    }
+    // Random walk over the history steps: noise[k] = Σ_{j<=k} velocity noise, noise[0] = 0.
+    Points noise = Points::Zero(v, 3);
+    for (int k = 1; k <= history; ++k) {
+      if (noise_std > 0.0) {
+        for (Eigen::Index i = 0; i < noise.size(); ++i) noise.data()[i] += normal(rng);
+      }
+      object.positions.middleRows(k * v, v) += noise;
+    }
+    // Target from the clean next frame, corrected by the last position's noise.
+    const Pose& next = trajectory.objects[o].poses[frame + 1];
+    const Points next_positions =
+        (object.mesh->vertices() * next.orientation.toRotationMatrix().transpose()).rowwise() +
+        next.position.transpose();
+    targets.middleRows(row, v) = next_positions - 2.0 * object.positions_at(history) +
+                                 object.positions_at(history - 1) + noise;
+    row += v;
+  }
+}
+
+void gather_targets(const Graph& graph, const std::vector<Points>& scene_targets,
+                    RowMatrixXf& targets, std::vector<std::uint8_t>& in_loss) {
+  targets.setZero(graph.num_mesh_nodes(), 3);
+  in_loss.assign(graph.num_mesh_nodes(), 0);
+  for (int s = 0; s < graph.num_scenes(); ++s) {
+    const int first_node = graph.object_first_node[graph.scene_first_object[s]];
+    const Points& t = scene_targets[s];
+    targets.middleRows(first_node, t.rows()) = t.cast<float>();
+    for (Eigen::Index i = 0; i < t.rows(); ++i) {
+      in_loss[first_node + i] = graph.node_kinematic[first_node + i] ? 0 : 1;
+    }
+  }
+}
+
+}  // namespace fignet

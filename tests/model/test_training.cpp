@@ -1,0 +1,106 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "../graph/scene_fixtures.h"
+#include "fignet/error.h"
+#include "fignet/rollout/predictor.h"
+#include "fignet/train/trainer.h"
+#include "trajectory_fixtures.h"
+
+namespace fignet {
+namespace {
+
+ModelConfig small_model() {
+  ModelConfig config = ModelConfig::preset_named("small");
+  config.latent_size = 32;
+  config.message_passing_steps = 2;
+  config.noise_std = 0.0;
+  return config;
+}
+
+std::vector<Trajectory> spinning_cubes(int frames) {
+  const double dt = 1.0 / 48.0;
+  Trajectory trajectory;
+  trajectory.time_step = dt;
+  trajectory.objects.push_back(testing::ballistic_object(testing::small_cube(), Vec3(0, 0, 2),
+                                                         Vec3(1, 0, 0), Vec3(0, 4, 2), frames, dt,
+                                                         Vec3(0, 0, -10)));
+  trajectory.objects.push_back(testing::ballistic_object(testing::small_cube(0.3), Vec3(0, 0.8, 2),
+                                                         Vec3(0, 1, 1), Vec3(-3, 0, 5), frames, dt,
+                                                         Vec3(0, 0, -10)));
+  return {trajectory};
+}
+
+TEST(Trainer, OverfitsOneShortTrajectoryByAHundredfold) {
+  const auto data = spinning_cubes(12);
+  TrainerConfig trainer_config;
+  trainer_config.batch_size = 4;
+  trainer_config.adam.decay_steps = 1500;
+  Trainer trainer(small_model(), trainer_config, data);
+  const std::vector<SampleRef> all = trainer.samples();
+  trainer.step();  // statistics from the first batch
+  const double before = trainer.evaluate_loss(all);
+  trainer.run(1500, nullptr);
+  const double after = trainer.evaluate_loss(all);
+  EXPECT_LT(after, before / 100.0) << "before " << before << ", after " << after;
+}
+
+TEST(Trainer, IsDeterministicForASeed) {
+  const auto data = spinning_cubes(10);
+  ModelConfig config = small_model();
+  config.noise_std = 1e-3;
+  Trainer a(config, {}, data), b(config, {}, data);
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(a.step().loss, b.step().loss);
+  EXPECT_EQ(a.parameters(), b.parameters());
+  TrainerConfig other;
+  other.seed = 2;
+  Trainer c(config, other, data);
+  for (int i = 0; i < 5; ++i) c.step();
+  EXPECT_NE(a.parameters(), c.parameters());
+}
+
+TEST(Trainer, RejectsDataWithoutSamples) {
+  EXPECT_THROW(Trainer(small_model(), {}, spinning_cubes(3)), ConfigError);
+}
+
+TEST(Model, OutputIsEquivariantToObjectOrder) {
+  ModelConfig config = small_model();
+  config.latent_size = 16;
+  auto fixture = testing::make_random_scene(13, 5, 0.6);
+  // Train a few steps so normalisers and weights are not at their symmetric initial values.
+  Model fresh(config);
+  std::vector<float> params = fresh.parameters();
+  std::mt19937 rng(1);
+  std::normal_distribution<float> noise(0.0f, 0.2f);
+  for (float& p : params) p += noise(rng);
+  Normalizers normalizers = fresh.normalizers();
+  Graph graph;
+  GraphBuilder(config.graph).build(fixture.scene, graph);
+  normalizers.mesh_node.accumulate(graph.mesh_nodes.matrix());
+  normalizers.face_edge.accumulate(graph.face_edges.features.matrix());
+  auto model = std::make_shared<const Model>(config, params, normalizers);
+  ModelPredictor predictor(model);
+  Points original, permuted;
+  predictor.predict(fixture.scene, original);
+  Scene reversed = fixture.scene;
+  std::reverse(reversed.objects.begin(), reversed.objects.end());
+  predictor.predict(reversed, permuted);
+  // Object o's rows in the reversed scene start after all the objects that now precede it.
+  std::vector<Eigen::Index> first(fixture.scene.objects.size() + 1, 0), first_rev(first);
+  const int n = static_cast<int>(fixture.scene.objects.size());
+  for (int o = 0; o < n; ++o)
+    first[o + 1] = first[o] + fixture.scene.objects[o].mesh->num_vertices();
+  for (int o = 0; o < n; ++o)
+    first_rev[o + 1] = first_rev[o] + reversed.objects[o].mesh->num_vertices();
+  for (int o = 0; o < n; ++o) {
+    const int v = fixture.scene.objects[o].mesh->num_vertices();
+    const auto a = original.middleRows(first[o], v);
+    const auto b = permuted.middleRows(first_rev[n - 1 - o], v);
+    EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-5 * (1.0 + a.cwiseAbs().maxCoeff()))
+        << "object " << o;
+  }
+}
+
+}  // namespace
+}  // namespace fignet
