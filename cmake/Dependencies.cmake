@@ -4,7 +4,7 @@ find_package(fmt REQUIRED)
 find_package(OpenMP REQUIRED)  # Eigen's GEMM threads
 find_package(CLI11 REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
-find_package(HDF5 REQUIRED COMPONENTS CXX)
+find_package(HDF5 REQUIRED COMPONENTS C CXX)
 if(FIGNET_BUILD_BULLET_PLUGIN)
   find_package(Bullet REQUIRED)  # CMake's FindBullet: BULLET_INCLUDE_DIRS / BULLET_LIBRARIES
   find_package(urdfdom REQUIRED)

@@ -25,4 +25,10 @@ class ConfigError : public Error {
   using Error::Error;
 };
 
+// A file that cannot be read or written: missing, truncated, foreign, wrong version or schema.
+class FileError : public Error {
+ public:
+  using Error::Error;
+};
+
 }  // namespace fignet

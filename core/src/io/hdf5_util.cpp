@@ -1,0 +1,167 @@
+#include "hdf5_util.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <sstream>
+
+#include "fignet/error.h"
+
+namespace fignet::hdf5 {
+
+namespace {
+
+// HDF5 prints its own error stack to stderr unless told not to; our exceptions say it better.
+void silence_hdf5() {
+  static const bool silenced = [] {
+    H5::Exception::dontPrint();
+    return true;
+  }();
+  (void)silenced;
+}
+
+std::vector<std::string> split(const std::string& path) {
+  std::vector<std::string> parts;
+  std::stringstream stream(path);
+  for (std::string part; std::getline(stream, part, '/');) {
+    if (!part.empty()) parts.push_back(part);
+  }
+  return parts;
+}
+
+}  // namespace
+
+H5::Group make_groups(H5::Group root, const std::string& path) {
+  H5::Group group = root;
+  for (const std::string& part : split(path)) {
+    group = group.nameExists(part) ? group.openGroup(part) : group.createGroup(part);
+  }
+  return group;
+}
+
+bool exists(const H5::Group& root, const std::string& path) {
+  H5::Group group = root;
+  const auto parts = split(path);
+  for (size_t i = 0; i < parts.size(); ++i) {
+    if (!group.nameExists(parts[i])) return false;
+    if (i + 1 < parts.size()) {
+      if (group.childObjType(parts[i]) != H5O_TYPE_GROUP) return false;
+      group = group.openGroup(parts[i]);
+    }
+  }
+  return true;
+}
+
+void write_attribute(H5::H5Object& object, const std::string& name, double value) {
+  object.createAttribute(name, H5::PredType::NATIVE_DOUBLE, H5::DataSpace())
+      .write(H5::PredType::NATIVE_DOUBLE, &value);
+}
+
+void write_attribute(H5::H5Object& object, const std::string& name, long long value) {
+  object.createAttribute(name, H5::PredType::NATIVE_LLONG, H5::DataSpace())
+      .write(H5::PredType::NATIVE_LLONG, &value);
+}
+
+void write_attribute(H5::H5Object& object, const std::string& name, const std::string& value) {
+  const H5::StrType type(H5::PredType::C_S1, value.empty() ? 1 : value.size());
+  object.createAttribute(name, type, H5::DataSpace()).write(type, value);
+}
+
+double read_double(const H5::H5Object& object, const std::string& name) {
+  double value = 0;
+  object.openAttribute(name).read(H5::PredType::NATIVE_DOUBLE, &value);
+  return value;
+}
+
+long long read_integer(const H5::H5Object& object, const std::string& name) {
+  long long value = 0;
+  object.openAttribute(name).read(H5::PredType::NATIVE_LLONG, &value);
+  return value;
+}
+
+std::string read_string(const H5::H5Object& object, const std::string& name) {
+  const H5::Attribute attribute = object.openAttribute(name);
+  std::string value;
+  attribute.read(attribute.getStrType(), value);
+  return value;
+}
+
+template <class T>
+void write_dataset(H5::Group& group, const std::string& path, const T* data,
+                   const std::vector<hsize_t>& shape, const H5::PredType& memory,
+                   const H5::PredType& file) {
+  const auto slash = path.rfind('/');
+  H5::Group parent = slash == std::string::npos ? group : make_groups(group, path.substr(0, slash));
+  const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  const H5::DataSpace space(static_cast<int>(shape.size()), shape.data());
+  parent.createDataSet(name, file, space).write(data, memory);
+}
+
+void write_floats(H5::Group& group, const std::string& path, const float* data,
+                  const std::vector<hsize_t>& shape) {
+  write_dataset(group, path, data, shape, H5::PredType::NATIVE_FLOAT, H5::PredType::IEEE_F32LE);
+}
+
+void write_doubles(H5::Group& group, const std::string& path, const double* data,
+                   const std::vector<hsize_t>& shape) {
+  write_dataset(group, path, data, shape, H5::PredType::NATIVE_DOUBLE, H5::PredType::IEEE_F64LE);
+}
+
+std::vector<hsize_t> shape_of(const H5::DataSet& dataset) {
+  const H5::DataSpace space = dataset.getSpace();
+  std::vector<hsize_t> shape(space.getSimpleExtentNdims());
+  space.getSimpleExtentDims(shape.data());
+  return shape;
+}
+
+void read_floats(const H5::DataSet& dataset, float* out) {
+  dataset.read(out, H5::PredType::NATIVE_FLOAT);
+}
+
+void read_doubles(const H5::DataSet& dataset, double* out) {
+  dataset.read(out, H5::PredType::NATIVE_DOUBLE);
+}
+
+void write_atomically(const std::filesystem::path& path, const std::string& what,
+                      const std::function<void(H5::H5File&)>& write) {
+  silence_hdf5();
+  std::filesystem::path temporary = path;
+  temporary += fmt::format(".tmp-{}", ::getpid());
+  try {
+    {
+      H5::H5File file(temporary.string(), H5F_ACC_TRUNC);
+      write(file);
+    }  // closed (and flushed) before the rename
+    std::filesystem::rename(temporary, path);
+  } catch (const H5::Exception& e) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw FileError(
+        fmt::format("{} '{}': cannot write ({})", what, path.string(), e.getDetailMsg()));
+  } catch (const std::filesystem::filesystem_error& e) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw FileError(fmt::format("{} '{}': cannot write ({})", what, path.string(), e.what()));
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw;
+  }
+}
+
+H5::H5File open_for_reading(const std::filesystem::path& path, const std::string& what) {
+  silence_hdf5();
+  if (!std::filesystem::exists(path)) {
+    throw FileError(fmt::format("{} '{}': no such file", what, path.string()));
+  }
+  try {
+    return H5::H5File(path.string(), H5F_ACC_RDONLY);
+  } catch (const H5::Exception&) {
+    throw FileError(
+        fmt::format("{} '{}': not a readable HDF5 file (truncated or of another "
+                    "format)",
+                    what, path.string()));
+  }
+}
+
+}  // namespace fignet::hdf5

@@ -1,0 +1,41 @@
+// Internal helpers over HDF5's C++ API: nested paths, typed attributes and datasets, errors that
+// name the file and the object, and atomic writes (temporary file, then rename).
+#pragma once
+
+#include <H5Cpp.h>
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace fignet::hdf5 {
+
+// Opens (creating as needed) every group along "a/b/c" below `root`.
+H5::Group make_groups(H5::Group root, const std::string& path);
+bool exists(const H5::Group& root, const std::string& path);
+
+void write_attribute(H5::H5Object& object, const std::string& name, double value);
+void write_attribute(H5::H5Object& object, const std::string& name, long long value);
+void write_attribute(H5::H5Object& object, const std::string& name, const std::string& value);
+double read_double(const H5::H5Object& object, const std::string& name);
+long long read_integer(const H5::H5Object& object, const std::string& name);
+std::string read_string(const H5::H5Object& object, const std::string& name);
+
+// Row-major datasets of floats or doubles with the given shape.
+void write_floats(H5::Group& group, const std::string& path, const float* data,
+                  const std::vector<hsize_t>& shape);
+void write_doubles(H5::Group& group, const std::string& path, const double* data,
+                   const std::vector<hsize_t>& shape);
+std::vector<hsize_t> shape_of(const H5::DataSet& dataset);
+void read_floats(const H5::DataSet& dataset, float* out);
+void read_doubles(const H5::DataSet& dataset, double* out);
+
+// Runs `write` on a temporary file beside `path` and renames it into place; on any failure the
+// temporary file is removed and nothing is left at `path`. HDF5 errors become FileError.
+void write_atomically(const std::filesystem::path& path, const std::string& what,
+                      const std::function<void(H5::H5File&)>& write);
+// Opens `path` read-only; throws FileError naming it when it is missing or not HDF5.
+H5::H5File open_for_reading(const std::filesystem::path& path, const std::string& what);
+
+}  // namespace fignet::hdf5

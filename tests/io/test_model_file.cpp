@@ -1,0 +1,112 @@
+#include <H5Cpp.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "fignet/error.h"
+#include "fignet/io/model_file.h"
+
+namespace fignet {
+namespace {
+
+namespace fs = std::filesystem;
+
+class ModelFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("fignet_model_file_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+    ModelConfig config = ModelConfig::preset_named("small");
+    config.latent_size = 16;
+    config.message_passing_steps = 2;
+    config.seed = 42;
+    Model fresh(config);
+    Normalizers normalizers = fresh.normalizers();
+    RowMatrixXf rows = RowMatrixXf::Random(10, normalizers.mesh_node.size());
+    normalizers.mesh_node.accumulate(rows);
+    model_ = std::make_unique<Model>(config, fresh.parameters(), normalizers);
+    path_ = dir_ / "model.h5";
+    save_model(*model_, path_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string load_error(const fs::path& path) {
+    try {
+      load_model(path);
+    } catch (const FileError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "no FileError";
+    return {};
+  }
+
+  fs::path dir_, path_;
+  std::unique_ptr<Model> model_;
+};
+
+void expect_contains(const std::string& text, const std::string& part) {
+  EXPECT_NE(text.find(part), std::string::npos) << "'" << text << "' lacks '" << part << "'";
+}
+
+TEST_F(ModelFile, SaveThenLoadIsBitExact) {
+  const Model loaded = load_model(path_);
+  EXPECT_EQ(loaded.parameters(), model_->parameters());
+  EXPECT_EQ(loaded.config().latent_size, 16);
+  EXPECT_EQ(loaded.config().seed, 42u);
+  EXPECT_EQ(loaded.config().graph.collision_radius, model_->config().graph.collision_radius);
+  EXPECT_EQ(loaded.config().time_step, model_->config().time_step);
+  EXPECT_EQ(loaded.normalizers().mesh_node.sum(), model_->normalizers().mesh_node.sum());
+  EXPECT_EQ(loaded.normalizers().mesh_node.sum_squares(),
+            model_->normalizers().mesh_node.sum_squares());
+  EXPECT_EQ(loaded.normalizers().mesh_node.count(), 10.0);
+  EXPECT_EQ(loaded.normalizers().mesh_node.accumulations(), 1);
+  // No temporary file is left beside the model.
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+TEST_F(ModelFile, MissingTruncatedAndForeignFilesFailClearly) {
+  expect_contains(load_error(dir_ / "absent.h5"), "no such file");
+  const auto size = fs::file_size(path_);
+  fs::copy_file(path_, dir_ / "truncated.h5");
+  fs::resize_file(dir_ / "truncated.h5", size / 2);
+  expect_contains(load_error(dir_ / "truncated.h5"), "not a readable HDF5 file");
+  std::ofstream(dir_ / "text.h5") << "not hdf5";
+  expect_contains(load_error(dir_ / "text.h5"), "not a readable HDF5 file");
+  { H5::H5File(std::string(dir_ / "foreign.h5"), H5F_ACC_TRUNC).createGroup("data"); }
+  expect_contains(load_error(dir_ / "foreign.h5"), "not a fignet model");
+}
+
+TEST_F(ModelFile, OtherVersionMissingTensorAndWrongShapeFailClearly) {
+  {
+    H5::H5File file(path_.string(), H5F_ACC_RDWR);
+    file.openGroup("/").removeAttr("version");
+    const long long version = 99;
+    file.openGroup("/")
+        .createAttribute("version", H5::PredType::NATIVE_LLONG, H5::DataSpace())
+        .write(H5::PredType::NATIVE_LLONG, &version);
+  }
+  expect_contains(load_error(path_), "format version 99 is not supported");
+  save_model(*model_, path_);
+  { H5::H5File(path_.string(), H5F_ACC_RDWR).unlink("parameters/decoder/mesh_node/linear_2/b"); }
+  expect_contains(load_error(path_), "missing tensor 'parameters/decoder/mesh_node/linear_2/b'");
+  save_model(*model_, path_);
+  {
+    H5::H5File file(path_.string(), H5F_ACC_RDWR);
+    file.unlink("parameters/decoder/mesh_node/linear_2/b");
+    const hsize_t shape[2] = {1, 4};
+    const float zeros[4] = {};
+    file.openGroup("parameters/decoder/mesh_node/linear_2")
+        .createDataSet("b", H5::PredType::IEEE_F32LE, H5::DataSpace(2, shape))
+        .write(zeros, H5::PredType::NATIVE_FLOAT);
+  }
+  expect_contains(load_error(path_), "has shape [1, 4], expected [1, 3]");
+}
+
+TEST_F(ModelFile, UnwritablePathFailsAndLeavesNothing) {
+  EXPECT_THROW(save_model(*model_, dir_ / "missing_dir" / "model.h5"), FileError);
+  EXPECT_FALSE(fs::exists(dir_ / "missing_dir"));
+}
+
+}  // namespace
+}  // namespace fignet
