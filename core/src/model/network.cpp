@@ -257,6 +257,32 @@ ConstMatrixView Network::forward(const float* params, const Normalizers& normali
   return {ws.output.get().data(), nodes, 3};
 }
 
+double Network::forward_flops(const Graph& graph) const {
+  const double l = config_.latent_size, m = config_.message_passing_steps;
+  const double nodes = graph.num_mesh_nodes(), objects = graph.object_nodes.rows();
+  const double faces = graph.face_edges.size();
+  // An MLP over n rows whose first product is already formed: two more layers.
+  auto tail = [&](double n, double out) { return 2.0 * n * (l * l + l * out); };
+  auto dense = [&](double n, double in, double out) { return 2.0 * n * in * l + tail(n, out); };
+  double flops = dense(nodes, sizes_.mesh_node, l) + dense(nodes, l, 3);  // encoder, decoder
+  if (config_.graph.object_nodes) flops += dense(objects, sizes_.object_node, l);
+  if (face_edges_) flops += dense(faces, sizes_.face_edge, 3 * l);
+  double per_step = 0.0;
+  int mesh_blocks = 1 + (face_edges_ ? 1 : 0);
+  for (int t = 0; t < static_cast<int>(edge_kinds_.size()); ++t) {
+    const double edges = edges_of(graph, t).size();
+    flops += dense(edges, edges_of(graph, t).features.cols(), l);
+    const double senders = sender_set(t) == NodeSet::kMesh ? nodes : objects;
+    const double receivers = receiver_set(t) == NodeSet::kMesh ? nodes : objects;
+    per_step += 2.0 * (edges + senders + receivers) * l * l + tail(edges, l);
+    if (receiver_set(t) == NodeSet::kMesh) ++mesh_blocks;
+  }
+  if (face_edges_) per_step += 2.0 * 3 * (faces + 2 * nodes) * l * l + tail(faces, 3 * l);
+  if (config_.graph.object_nodes) per_step += 2.0 * objects * 2 * l * l + tail(objects, l);
+  per_step += 2.0 * nodes * mesh_blocks * l * l + tail(nodes, l);
+  return flops + m * per_step;
+}
+
 void Network::backward(const float* params, float* grads, const Graph& graph,
                        const ConstMatrixRef& d_output, NetworkWorkspace& workspace) const {
   NetworkWorkspace::State& ws = *workspace.state_;

@@ -54,6 +54,10 @@ class Network {
   // every level's activations stay in the workspace for backward().
   ConstMatrixView forward(const float* params, const Normalizers& normalizers, const Graph& graph,
                           NetworkWorkspace& ws, bool keep_for_backward) const;
+  // Floating-point operations of one forward() on `graph` (matrix products, as implemented: node
+  // blocks of edge updates are multiplied once per node). A backward costs about twice as much.
+  double forward_flops(const Graph& graph) const;
+
   // Accumulates d(loss)/d(params) into `grads`, given d(loss)/d(output) of the last forward.
   void backward(const float* params, float* grads, const Graph& graph,
                 const ConstMatrixRef& d_output, NetworkWorkspace& ws) const;
