@@ -5,6 +5,7 @@
 #include "../graph/scene_fixtures.h"
 #include "fignet/error.h"
 #include "fignet/rollout/predictor.h"
+#include "fignet/rollout/rollout.h"
 #include "fignet/train/trainer.h"
 #include "trajectory_fixtures.h"
 
@@ -62,6 +63,28 @@ TEST(Trainer, IsDeterministicForASeed) {
 
 TEST(Trainer, RejectsDataWithoutSamples) {
   EXPECT_THROW(Trainer(small_model(), {}, spinning_cubes(3)), ConfigError);
+}
+
+TEST(Model, RolloutThroughAModelIsFiniteAndCountsFaceEdges) {
+  auto data = spinning_cubes(10);
+  // A floor 5 cm below the first cube's lowest vertex at frame 2, the first frame predicted from.
+  const TrajectoryObject& cube = data[0].objects[0];
+  const Points posed =
+      cube.mesh->vertices() * cube.poses[2].orientation.toRotationMatrix().transpose();
+  data[0].floor = Floor{cube.poses[2].position.z() + posed.col(2).minCoeff() - 0.05};
+  Trainer trainer(small_model(), {}, data);
+  trainer.run(3, nullptr);
+  ModelPredictor predictor(trainer.model());
+  std::vector<int> face_edges;
+  const Trajectory predicted = rollout(predictor, data[0], -1, &face_edges);
+  ASSERT_EQ(face_edges.size(), 10u - 3u);  // frames 3 … 9 are predicted
+  for (const TrajectoryObject& object : predicted.objects) {
+    for (const Pose& pose : object.poses) {
+      EXPECT_TRUE(pose.position.allFinite());
+      EXPECT_NEAR(pose.orientation.norm(), 1.0, 1e-9);
+    }
+  }
+  EXPECT_GT(face_edges.front(), 0);  // cube–floor face pairs within d_c = 0.1 m
 }
 
 TEST(Model, OutputIsEquivariantToObjectOrder) {

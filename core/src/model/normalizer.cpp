@@ -1,5 +1,6 @@
 #include "fignet/model/normalizer.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace fignet {
@@ -7,7 +8,9 @@ namespace fignet {
 Normalizer::Normalizer(int size, std::int64_t max_accumulations)
     : max_accumulations_(max_accumulations),
       sum_(Eigen::VectorXd::Zero(size)),
-      sum_squares_(Eigen::VectorXd::Zero(size)) {}
+      sum_squares_(Eigen::VectorXd::Zero(size)) {
+  update_cache();
+}
 
 void Normalizer::accumulate(const ConstMatrixRef& rows) {
   if (frozen() || rows.rows() == 0) return;
@@ -16,34 +19,31 @@ void Normalizer::accumulate(const ConstMatrixRef& rows) {
   sum_squares_ += values.array().square().colwise().sum().matrix().transpose();
   count_ += static_cast<double>(rows.rows());
   ++accumulations_;
+  update_cache();
 }
 
-Eigen::RowVectorXf Normalizer::mean() const {
-  if (count_ == 0.0) return Eigen::RowVectorXf::Zero(size());
-  return (sum_ / count_).transpose().cast<float>();
-}
-
-Eigen::RowVectorXf Normalizer::std() const {
-  Eigen::RowVectorXf result = Eigen::RowVectorXf::Ones(size());
-  if (count_ == 0.0) return result;
-  for (int c = 0; c < size(); ++c) {
-    const double mean = sum_[c] / count_;
-    const double variance = std::max(sum_squares_[c] / count_ - mean * mean, 0.0);
-    const double std = std::sqrt(variance);
-    if (std > kStdEpsilon) result[c] = static_cast<float>(std);
+void Normalizer::update_cache() {
+  const int n = size();
+  mean_ = Eigen::RowVectorXf::Zero(n);
+  std_ = Eigen::RowVectorXf::Ones(n);
+  if (count_ > 0.0) {
+    for (int c = 0; c < n; ++c) {
+      const double mean = sum_[c] / count_;
+      const double variance = std::max(sum_squares_[c] / count_ - mean * mean, 0.0);
+      mean_[c] = static_cast<float>(mean);
+      if (std::sqrt(variance) > kStdEpsilon) std_[c] = static_cast<float>(std::sqrt(variance));
+    }
   }
-  return result;
+  inverse_std_ = std_.cwiseInverse();
 }
 
 void Normalizer::normalize(const ConstMatrixRef& in, MatrixRef out) const {
-  const Eigen::RowVectorXf m = mean(), inv = std().cwiseInverse();
-  out = ((in.rowwise() - m).array().rowwise() * inv.array()).matrix();
+  out = ((in.rowwise() - mean_).array().rowwise() * inverse_std_.array()).matrix();
 }
 
 void Normalizer::denormalize(const ConstMatrixRef& in, MatrixRef out) const {
-  const Eigen::RowVectorXf m = mean(), s = std();
-  out = (in.array().rowwise() * s.array()).matrix();
-  out.rowwise() += m;
+  out = (in.array().rowwise() * std_.array()).matrix();
+  out.rowwise() += mean_;
 }
 
 void Normalizer::set_state(std::int64_t accumulations, double count, Eigen::VectorXd sum,
@@ -52,6 +52,7 @@ void Normalizer::set_state(std::int64_t accumulations, double count, Eigen::Vect
   count_ = count;
   sum_ = std::move(sum);
   sum_squares_ = std::move(sum_squares);
+  update_cache();
 }
 
 }  // namespace fignet

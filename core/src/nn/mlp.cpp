@@ -76,12 +76,13 @@ void Mlp::backward(const float* params, float* grads, const ConstMatrixRef& d_ou
     grad_row(scale_, output_) += (d_out.array() * normalized.array()).colwise().sum().matrix();
     grad_row(offset_, output_) += d_out.colwise().sum();
     const auto scale = tensor(params, scale_, 1, output_).row(0).array();
+    // d_pre first holds dx̂ = d_out·scale, then is turned into dx row by row in place.
+    d_pre = (d_out.array().rowwise() * scale).matrix();
     for (Eigen::Index r = 0; r < n; ++r) {
-      const Eigen::RowVectorXf d_norm = (d_out.row(r).array() * scale).matrix();
-      const float mean_d = d_norm.mean();
-      const float mean_dx = d_norm.dot(normalized.row(r)) / static_cast<float>(output_);
-      d_pre.row(r) =
-          inv_std(r, 0) * (d_norm.array() - mean_d - normalized.row(r).array() * mean_dx).matrix();
+      const float mean_d = d_pre.row(r).mean();
+      const float mean_dx = d_pre.row(r).dot(normalized.row(r)) / static_cast<float>(output_);
+      d_pre.row(r) = inv_std(r, 0) *
+                     (d_pre.row(r).array() - mean_d - normalized.row(r).array() * mean_dx).matrix();
     }
   } else {
     d_pre = d_out;

@@ -34,7 +34,8 @@ void predict_next_poses(AccelerationPredictor& predictor, const Scene& scene,
   }
 }
 
-Trajectory rollout(AccelerationPredictor& predictor, const Trajectory& truth, int frames) {
+Trajectory rollout(AccelerationPredictor& predictor, const Trajectory& truth, int frames,
+                   std::vector<int>* face_edges) {
   truth.validate();
   const int total = frames < 0 ? truth.num_frames() : std::min(frames, truth.num_frames());
   const int h = predictor.history();
@@ -42,9 +43,11 @@ Trajectory rollout(AccelerationPredictor& predictor, const Trajectory& truth, in
   Scene scene;
   StepWorkspace workspace;
   std::vector<Pose> next;
+  if (face_edges) face_edges->clear();
   for (int t = h; t + 1 < total; ++t) {
     scene_at_frame(predicted, t, h, scene);
     predict_next_poses(predictor, scene, next, workspace);
+    if (face_edges) face_edges->push_back(predictor.last_face_edges());
     for (size_t o = 0; o < predicted.objects.size(); ++o) {
       if (!predicted.objects[o].kinematic) predicted.objects[o].poses[t + 1] = next[o];
     }

@@ -25,8 +25,8 @@ class Normalizer {
   void normalize(const ConstMatrixRef& in, MatrixRef out) const;
   // out = in·std + mean.
   void denormalize(const ConstMatrixRef& in, MatrixRef out) const;
-  Eigen::RowVectorXf mean() const;
-  Eigen::RowVectorXf std() const;
+  const Eigen::RowVectorXf& mean() const { return mean_; }
+  const Eigen::RowVectorXf& std() const { return std_; }
   int size() const { return static_cast<int>(sum_.size()); }
 
   // Raw state, for model files and for merging statistics across processes.
@@ -40,8 +40,13 @@ class Normalizer {
 
  private:
   std::int64_t accumulations_ = 0, max_accumulations_ = 1;
+  // Recomputes the cached mean and std from the sums (after every change of them), so that
+  // normalising a step allocates nothing.
+  void update_cache();
+
   double count_ = 0.0;
   Eigen::VectorXd sum_, sum_squares_;
+  Eigen::RowVectorXf mean_, std_, inverse_std_;
 };
 
 }  // namespace fignet

@@ -18,6 +18,8 @@ class AccelerationPredictor {
   // One row per node of scene.objects, in order: the finite-difference acceleration
   // x^{t+1} − 2x^t + x^{t−1} in metres (rows of kinematic objects are ignored by callers).
   virtual void predict(const Scene& scene, Points& accelerations) = 0;
+  // Face–face edges of the last prediction's graph (0 for predictors without a graph).
+  virtual int last_face_edges() const { return 0; }
 };
 
 // Runs a FIGNet model: builds the graph, runs the network, un-normalises. One per thread.
@@ -26,6 +28,7 @@ class ModelPredictor : public AccelerationPredictor {
   explicit ModelPredictor(std::shared_ptr<const Model> model);
   int history() const override { return model_->config().graph.history; }
   void predict(const Scene& scene, Points& accelerations) override;
+  int last_face_edges() const override { return graph_.face_edges.size(); }
   // The graph of the last prediction (for edge counts and debug drawing).
   const Graph& last_graph() const { return graph_; }
   const GraphBuilder& builder() const { return builder_; }

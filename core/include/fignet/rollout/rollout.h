@@ -19,7 +19,9 @@ void predict_next_poses(AccelerationPredictor& predictor, const Scene& scene,
                         std::vector<Pose>& next, StepWorkspace& workspace);
 
 // Replays `truth` from its first h+1 frames: dynamic objects are predicted for frames h+1 …
-// frames−1 (all frames when frames < 0), kinematic ones copied from `truth`.
-Trajectory rollout(AccelerationPredictor& predictor, const Trajectory& truth, int frames = -1);
+// frames−1 (all frames when frames < 0), kinematic ones copied from `truth`. When given,
+// `face_edges` receives the face–face edge count of each predicted step.
+Trajectory rollout(AccelerationPredictor& predictor, const Trajectory& truth, int frames = -1,
+                   std::vector<int>* face_edges = nullptr);
 
 }  // namespace fignet
