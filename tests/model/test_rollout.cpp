@@ -99,6 +99,11 @@ TEST(Metrics, PenetrationCountsCrossingFacesAndDepth) {
   EXPECT_EQ(apart.depth, 0.0);
   scene.objects[1].poses[0].position.z() = 0.3;  // 0.2 m below the floor: 4 bottom vertices
   EXPECT_NEAR(measure_penetration(scene, 0).depth, 4 * 0.2, 1e-12);
+  // A rollout sinking twice as deep as the truth has a depth ratio of 2.
+  Trajectory deeper = scene;
+  deeper.objects[1].poses[0].position.z() = 0.1;
+  EXPECT_NEAR(penetration_ratio(deeper, scene, 0).depth, 2.0, 1e-12);
+  EXPECT_TRUE(std::isnan(penetration_ratio(deeper, scene, 0).count));  // no crossings in truth
 }
 
 }  // namespace

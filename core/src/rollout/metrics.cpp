@@ -123,4 +123,17 @@ Penetration measure_penetration(const Trajectory& trajectory, int frame) {
   return result;
 }
 
+PenetrationRatio penetration_ratio(const Trajectory& predicted, const Trajectory& truth,
+                                   int first) {
+  double depth[2] = {0, 0}, count[2] = {0, 0};
+  const int frames = std::min(predicted.num_frames(), truth.num_frames());
+  for (int f = first; f < frames; ++f) {
+    const Penetration p = measure_penetration(predicted, f), t = measure_penetration(truth, f);
+    depth[0] += p.depth, depth[1] += t.depth;
+    count[0] += p.intersecting_face_pairs, count[1] += t.intersecting_face_pairs;
+  }
+  auto ratio = [](double a, double b) { return b > 0 ? a / b : std::nan(""); };
+  return {ratio(depth[0], depth[1]), ratio(count[0], count[1])};
+}
+
 }  // namespace fignet

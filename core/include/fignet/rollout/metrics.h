@@ -32,4 +32,12 @@ struct Penetration {
 // Penetration of one frame. Objects must be closed meshes for the inside test.
 Penetration measure_penetration(const Trajectory& trajectory, int frame);
 
+// Seed table H.1: penetration of a rollout as a ratio to the ground truth's on the same scene,
+// summed over frames [first, end): depth ratio and crossing-face-pair count ratio (NaN where the
+// ground truth has none).
+struct PenetrationRatio {
+  double depth = 0.0, count = 0.0;
+};
+PenetrationRatio penetration_ratio(const Trajectory& predicted, const Trajectory& truth, int first);
+
 }  // namespace fignet
