@@ -14,6 +14,12 @@ void write_posed(const TriangleMesh& mesh, const Pose& pose, Eigen::Ref<Points> 
 
 }  // namespace
 
+Points posed_vertices(const TriangleMesh& mesh, const Pose& pose) {
+  Points out(mesh.num_vertices(), 3);
+  write_posed(mesh, pose, out);
+  return out;
+}
+
 void set_pose_history(SceneObject& object, std::span<const Pose> poses,
                       const std::optional<Pose>& next_pose) {
   if (object.mesh == nullptr) throw ConfigError("set_pose_history: the object has no mesh");

@@ -87,10 +87,7 @@ Penetration measure_penetration(const Trajectory& trajectory, int frame) {
   std::vector<PosedMesh> meshes;
   for (size_t o = 0; o < trajectory.objects.size(); ++o) {
     const TrajectoryObject& object = trajectory.objects[o];
-    const Pose& pose = object.poses[frame];
-    posed[o] =
-        (object.mesh->vertices() * pose.orientation.toRotationMatrix().transpose()).rowwise() +
-        pose.position.transpose();
+    posed[o] = posed_vertices(*object.mesh, object.poses[frame]);
     meshes.push_back({object.mesh.get(), posed[o].data(), object.kinematic});
   }
   ContactFinder finder;

@@ -36,10 +36,8 @@ void make_noisy_sample(const Trajectory& trajectory, int frame, int history, dou
       object.positions.middleRows(k * v, v) += noise;
     }
     // Target from the clean next frame, corrected by the last position's noise.
-    const Pose& next = trajectory.objects[o].poses[frame + 1];
     const Points next_positions =
-        (object.mesh->vertices() * next.orientation.toRotationMatrix().transpose()).rowwise() +
-        next.position.transpose();
+        posed_vertices(*object.mesh, trajectory.objects[o].poses[frame + 1]);
     targets.middleRows(row, v) = next_positions - 2.0 * object.positions_at(history) +
                                  object.positions_at(history - 1) + noise;
     row += v;

@@ -47,6 +47,9 @@ struct SceneObject {
   }
 };
 
+// The mesh's rest vertices moved by `pose` (world frame).
+Points posed_vertices(const TriangleMesh& mesh, const Pose& pose);
+
 // Fills positions/centers from rigid poses (oldest first) and, for kinematic objects, the
 // next pose. Reuses the object's buffers.
 void set_pose_history(SceneObject& object, std::span<const Pose> poses,
