@@ -3,6 +3,7 @@
 // compared against.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -17,6 +18,8 @@ struct TrajectoryObject {
   StaticProperties properties;
   bool kinematic = false;
   std::vector<Pose> poses;  // one per frame
+  // Per frame, when recorded (empty otherwise): centre-of-mass velocity and angular velocity.
+  std::vector<Vec3> linear_velocities, angular_velocities;
 };
 
 struct Trajectory {
@@ -24,6 +27,7 @@ struct Trajectory {
   std::optional<Floor> floor;
   double time_step = 1.0 / 48.0;  // seconds between frames
   Vec3 gravity = Vec3(0, 0, -10);
+  std::uint64_t seed = 0;  // the generator's seed for this trajectory
 
   int num_frames() const { return objects.empty() ? 0 : static_cast<int>(objects[0].poses.size()); }
   // Throws ConfigError when objects disagree on frame count or a pose is not finite.
