@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", FIGNET_VERSION);
   add_info_command(app);
   fignet::cli::add_graph_stats_command(app);
+  fignet::cli::add_generate_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

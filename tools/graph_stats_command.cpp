@@ -6,7 +6,9 @@
 #include <map>
 
 #include "commands.h"
+#include "fignet/data/trajectory.h"
 #include "fignet/graph/graph_builder.h"
+#include "fignet/io/trajectory_file.h"
 #include "fignet/scenes/resting_lattice.h"
 
 namespace fignet::cli {
@@ -14,15 +16,46 @@ namespace fignet::cli {
 namespace {
 
 struct GraphStatsOptions {
+  std::string data;  // a trajectory file: statistics over its frames instead of the lattice
+  int max_trajectories = 100;
   RestingLatticeOptions scene;
   GraphConfig graph;
   bool no_object_nodes = false;
   int repeat = 20;
 };
 
+// Mean edges per frame over the frames of a dataset (each frame's graph built as in training).
+void run_dataset_stats(const GraphStatsOptions& options, const GraphConfig& config) {
+  DatasetInfo info;
+  const std::vector<Trajectory> data = read_trajectories(options.data, &info);
+  GraphBuilder builder(config);
+  Graph graph;
+  Scene scene;
+  double frames = 0, face_edges = 0, world_edges = 0, nodes = 0, objects = 0;
+  const int count = std::min<int>(options.max_trajectories, static_cast<int>(data.size()));
+  for (int i = 0; i < count; ++i) {
+    for (int t = config.history; t < data[i].num_frames(); ++t) {
+      scene_at_frame(data[i], t, config.history, scene);
+      builder.build(scene, graph);
+      frames += 1;
+      face_edges += graph.face_edges.size();
+      world_edges += graph.world_edges.size();
+      nodes += graph.num_mesh_nodes();
+      objects += static_cast<double>(scene.objects.size());
+    }
+  }
+  fmt::print("{}: {} trajectories (preset {}), {} frames examined, collision radius {} m\n",
+             options.data, count, info.preset, frames, config.collision_radius);
+  fmt::print(
+      "per frame: {:.1f} objects, {:.1f} mesh nodes (floor included), {:.1f} face-face edges, "
+      "{:.1f} world edges\n",
+      objects / frames, nodes / frames, face_edges / frames, world_edges / frames);
+}
+
 void run_graph_stats(const GraphStatsOptions& options) {
   GraphConfig config = options.graph;
   config.object_nodes = !options.no_object_nodes;
+  if (!options.data.empty()) return run_dataset_stats(options, config);
   RestingLatticeOptions scene_options = options.scene;
   scene_options.history = config.history;
   const RestingLattice lattice = make_resting_lattice(scene_options);
@@ -66,6 +99,13 @@ void add_graph_stats_command(CLI::App& app) {
   auto options = std::make_shared<GraphStatsOptions>();
   auto* cmd = app.add_subcommand(
       "graph-stats", "Build the FIGNet input graph of a built-in scene and print its statistics");
+  cmd->add_option(
+      "--data", options->data,
+      "Trajectory file: mean edges per frame over its frames instead of the built-in scene");
+  cmd->add_option("--max-trajectories", options->max_trajectories,
+                  "With --data: examine at most this many trajectories")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->add_option("--objects", options->scene.objects, "Number of objects in the scene")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();

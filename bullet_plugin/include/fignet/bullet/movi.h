@@ -1,0 +1,30 @@
+// Kubric MOVi scene presets (facts §1) as SceneSpecs: objects tossed toward the centre onto a
+// floor, Bullet at 240 Hz, one frame every 5 steps.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fignet/bullet/scene_spec.h"
+
+namespace fignet::bullet {
+
+struct MoviOptions {
+  std::string preset = "movi-a";  // only "movi-a" so far
+  int min_objects = 3, max_objects = 10;
+  int frames = 96;
+};
+
+// The scene of `seed`: 3–10 objects from {cube, cylinder, sphere}, scale 0.7 or 1.4, metal
+// (friction 0.4, restitution 0.3, density 2.7) or rubber (0.8, 0.7, 1.1), random orientation,
+// positions uniform in (−5,−5,1)–(5,5,5) resampled (≤ 100 tries) until the object's bounding
+// sphere overlaps no earlier one and its lowest point is above the floor, and a horizontal
+// velocity uniform in (−4,−4,0)–(4,4,0) minus the spawn point's (x, y, 0): tossed toward the
+// centre. Floor friction 0.3, restitution 0.5; gravity (0, 0, −10). Throws ConfigError for a bad
+// option.
+SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed);
+
+const std::vector<std::string>& movi_presets();
+
+}  // namespace fignet::bullet

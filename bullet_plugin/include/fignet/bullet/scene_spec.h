@@ -1,0 +1,41 @@
+// A physics scene described independently of any engine: bodies (rest mesh in the principal
+// centre-of-mass frame, material, initial pose and velocity, kinematic flag), floor, gravity and
+// timing. The generator, native Bullet and FIGNetDynamicsWorld are all built from the same spec,
+// so they always see the same bodies.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "fignet/data/trajectory.h"
+
+namespace fignet::bullet {
+
+struct BodySpec {
+  std::shared_ptr<const TriangleMesh> mesh;           // principal centre-of-mass frame
+  StaticProperties properties;                        // mass = density × volume (0 when kinematic)
+  Eigen::Vector3d inertia = Eigen::Vector3d::Ones();  // principal moments, kg·m²
+  bool kinematic = false;
+  Pose pose;
+  Vec3 linear_velocity = Vec3::Zero(), angular_velocity = Vec3::Zero();
+};
+
+struct SceneSpec {
+  std::vector<BodySpec> bodies;
+  std::optional<Floor> floor;
+  Vec3 gravity = Vec3(0, 0, -10);
+  double physics_step = 1.0 / 240.0;  // seconds per Bullet step
+  int steps_per_frame = 5;            // 240 Hz / 5 = 48 Hz frames
+  int frames = 96;
+  std::uint64_t seed = 0;
+
+  double frame_step() const { return physics_step * steps_per_frame; }
+};
+
+// A body of `density` made from `mesh` in any frame: the mesh is moved to its principal
+// centre-of-mass frame (Bullet needs a diagonal inertia) and `pose` is the pose of that frame.
+BodySpec make_body(const TriangleMesh& mesh, double density, double friction, double restitution);
+
+}  // namespace fignet::bullet

@@ -1,0 +1,97 @@
+#include "fignet/bullet/movi.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <map>
+#include <mutex>
+#include <random>
+
+#include "fignet/error.h"
+#include "fignet/geometry/shapes.h"
+
+namespace fignet::bullet {
+
+namespace {
+
+struct Material {
+  double friction, restitution, density;
+};
+constexpr Material kMetal{0.4, 0.3, 2.7};
+constexpr Material kRubber{0.8, 0.7, 1.1};
+
+// One body template per (shape, scale, material), shared by every scene of the process.
+const BodySpec& body_template(const std::string& shape, double scale, const Material& material) {
+  static std::mutex mutex;
+  static std::map<std::tuple<std::string, double, double>, BodySpec> cache;
+  const std::lock_guard lock(mutex);
+  const auto key = std::tuple(shape, scale, material.density);
+  auto it = cache.find(key);
+  if (it == cache.end()) {
+    const TriangleMesh unit = make_movi_shape(shape);
+    const TriangleMesh scaled(shape, unit.vertices() * scale, unit.faces());
+    it = cache
+             .emplace(key,
+                      make_body(scaled, material.density, material.friction, material.restitution))
+             .first;
+  }
+  return it->second;
+}
+
+}  // namespace
+
+const std::vector<std::string>& movi_presets() {
+  static const std::vector<std::string> presets = {"movi-a"};
+  return presets;
+}
+
+SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
+  if (options.preset != "movi-a") {
+    throw ConfigError(fmt::format("unknown scene preset '{}'; available: {}", options.preset,
+                                  fmt::join(movi_presets(), ", ")));
+  }
+  if (options.min_objects < 1 || options.max_objects < options.min_objects) {
+    throw ConfigError(fmt::format("objects range {}..{} is empty or below 1", options.min_objects,
+                                  options.max_objects));
+  }
+  if (options.frames < 2)
+    throw ConfigError(fmt::format("frames = {} (needs >= 2)", options.frames));
+  SceneSpec spec;
+  spec.seed = seed;
+  spec.frames = options.frames;
+  spec.floor = Floor{0.0, {0.0, 0.3, 0.5}};
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal;
+  const char* shapes[] = {"cube", "cylinder", "sphere"};
+  const int count = options.min_objects +
+                    static_cast<int>(unit(rng) * (options.max_objects - options.min_objects + 1));
+  std::vector<std::pair<Vec3, double>> spheres;  // placed bodies' bounding spheres
+  for (int i = 0; i < std::min(count, options.max_objects); ++i) {
+    BodySpec body = body_template(shapes[static_cast<int>(unit(rng) * 3) % 3],
+                                  unit(rng) < 0.5 ? 0.7 : 1.4, unit(rng) < 0.5 ? kMetal : kRubber);
+    const double radius = body.mesh->vertices().rowwise().norm().maxCoeff();
+    bool placed = false;
+    for (int attempt = 0; attempt < 100 && !placed; ++attempt) {
+      body.pose.orientation =
+          Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
+      body.pose.position = Vec3(-5 + 10 * unit(rng), -5 + 10 * unit(rng), 1 + 4 * unit(rng));
+      const double lowest =
+          (body.mesh->vertices() * body.pose.orientation.toRotationMatrix().transpose())
+              .col(2)
+              .minCoeff();
+      placed = body.pose.position.z() + lowest > spec.floor->height;
+      for (const auto& [center, r] : spheres) {
+        placed = placed && (center - body.pose.position).norm() > r + radius;
+      }
+    }
+    if (!placed) continue;  // no free spot in 100 tries: the scene gets one object fewer
+    const Vec3 target(-4 + 8 * unit(rng), -4 + 8 * unit(rng), 0.0);
+    body.linear_velocity = target - Vec3(body.pose.position.x(), body.pose.position.y(), 0.0);
+    spheres.emplace_back(body.pose.position, radius);
+    spec.bodies.push_back(std::move(body));
+  }
+  return spec;
+}
+
+}  // namespace fignet::bullet

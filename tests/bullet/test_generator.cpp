@@ -1,0 +1,122 @@
+#include <gtest/gtest.h>
+
+#include "fignet/bullet/dataset_generator.h"
+#include "fignet/error.h"
+#include "fignet/geometry/mass_properties.h"
+#include "fignet/graph/contacts.h"
+
+namespace fignet::bullet {
+namespace {
+
+GenerateOptions small_options(int threads) {
+  GenerateOptions options;
+  options.count = 6;
+  options.seed = 11;
+  options.scene.frames = 48;
+  options.threads = threads;
+  return options;
+}
+
+void expect_identical(const std::vector<Trajectory>& a, const std::vector<Trajectory>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i].objects.size(), b[i].objects.size());
+    for (size_t o = 0; o < a[i].objects.size(); ++o) {
+      for (int f = 0; f < a[i].num_frames(); ++f) {
+        ASSERT_EQ(a[i].objects[o].poses[f].position, b[i].objects[o].poses[f].position);
+        ASSERT_EQ(a[i].objects[o].poses[f].orientation.coeffs(),
+                  b[i].objects[o].poses[f].orientation.coeffs());
+      }
+    }
+  }
+}
+
+TEST(Generator, SameSeedSameTrajectoriesWhateverTheThreadsAndShards) {
+  const auto one = generate_dataset(small_options(1));
+  expect_identical(one, generate_dataset(small_options(2)));
+  GenerateOptions first = small_options(2), second = small_options(2);
+  first.shards = second.shards = 2;
+  second.shard = 1;
+  auto sharded = generate_dataset(first);
+  for (auto& t : generate_dataset(second)) sharded.push_back(std::move(t));
+  expect_identical(one, sharded);
+  GenerateOptions other = small_options(2);
+  other.seed = 12;
+  EXPECT_NE(generate_dataset(other)[0].objects[0].poses[0].position,
+            one[0].objects[0].poses[0].position);
+}
+
+TEST(Generator, MoviAScenesFollowKubricParameters) {
+  for (std::uint64_t seed = 0; seed < 40; ++seed) {
+    const SceneSpec spec = sample_movi_scene({}, trajectory_seed(5, seed));
+    ASSERT_GE(spec.bodies.size(), 1u);
+    EXPECT_LE(spec.bodies.size(), 10u);
+    EXPECT_EQ(spec.floor->properties.friction, 0.3);
+    EXPECT_EQ(spec.floor->properties.restitution, 0.5);
+    for (const BodySpec& body : spec.bodies) {
+      // Mass = density × mesh volume; metal 2.7 or rubber 1.1 with their friction.
+      const double volume = compute_mass_properties(*body.mesh).volume;
+      const double density = body.properties.mass / volume;
+      EXPECT_TRUE(std::abs(density - 2.7) < 1e-9 || std::abs(density - 1.1) < 1e-9) << density;
+      EXPECT_EQ(body.properties.friction, density > 2 ? 0.4 : 0.8);
+      EXPECT_GE(body.pose.position.z(), 1.0);
+      EXPECT_LE(body.pose.position.cwiseAbs().maxCoeff(), 5.0);
+      EXPECT_EQ(body.linear_velocity.z(), 0.0);
+      // Tossed toward the centre: velocity = uniform(±4) − (x, y).
+      EXPECT_LE(
+          (body.linear_velocity.head<2>() + body.pose.position.head<2>()).cwiseAbs().maxCoeff(),
+          4.0);
+      if (body.mesh->name() == "cube") {
+        const double side = 2 * body.mesh->vertices().col(0).maxCoeff();
+        EXPECT_TRUE(std::abs(side - 1.4) < 1e-9 || std::abs(side - 2.8) < 1e-9) << side;
+        EXPECT_NEAR(volume, side * side * side, 1e-9);
+      }
+    }
+  }
+}
+
+TEST(Generator, ScenesStartWithoutOverlapAndStayAboveTheFloor) {
+  GenerateOptions options = small_options(2);
+  options.count = 10;
+  options.scene.frames = 96;
+  for (const Trajectory& t : generate_dataset(options)) {
+    // Frame 0: no two objects' surfaces touch (the bounding-sphere spawn test is conservative).
+    std::vector<Points> posed;
+    std::vector<PosedMesh> meshes;
+    for (const auto& object : t.objects)
+      posed.push_back(posed_vertices(*object.mesh, object.poses[0]));
+    for (size_t o = 0; o < t.objects.size(); ++o) {
+      meshes.push_back({t.objects[o].mesh.get(), posed[o].data(), false});
+    }
+    ContactFinder finder;
+    finder.update(meshes, false);
+    std::vector<ObjectPair> pairs;
+    std::vector<FacePair> touching;
+    finder.find_candidate_pairs(0.0, pairs);
+    finder.find_face_pairs(pairs, 0.0, touching);
+    EXPECT_TRUE(touching.empty()) << "seed " << t.seed;
+    // Every frame: every vertex above the floor, within Bullet's contact tolerance.
+    for (const auto& object : t.objects) {
+      for (const Pose& pose : object.poses) {
+        EXPECT_GE(posed_vertices(*object.mesh, pose).col(2).minCoeff(), -0.03) << "seed " << t.seed;
+      }
+    }
+  }
+}
+
+TEST(Generator, BadOptionsAreConfigErrors) {
+  GenerateOptions options = small_options(1);
+  options.shard = 2;
+  options.shards = 2;
+  EXPECT_THROW(generate_dataset(options), ConfigError);
+  options = small_options(1);
+  options.scene.preset = "movi-z";
+  EXPECT_THROW(generate_dataset(options), ConfigError);
+  options = small_options(1);
+  options.scene.min_objects = 5;
+  options.scene.max_objects = 4;
+  EXPECT_THROW(generate_dataset(options), ConfigError);
+}
+
+}  // namespace
+}  // namespace fignet::bullet

@@ -1,0 +1,98 @@
+// `fignet generate`: simulates Kubric-style scenes in Bullet and writes a trajectory file.
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <future>
+#include <regex>
+#include <thread>
+
+#include "commands.h"
+#include "fignet/bullet/dataset_generator.h"
+#include "fignet/error.h"
+#include "fignet/io/trajectory_file.h"
+#include "progress.h"
+
+#ifndef FIGNET_VERSION
+#define FIGNET_VERSION "unknown"
+#endif
+
+namespace fignet::cli {
+
+namespace {
+
+struct GenerateArgs {
+  bullet::GenerateOptions options;
+  std::string shard = "0/1";
+  std::filesystem::path out;
+};
+
+void run_generate(GenerateArgs args) {
+  std::smatch match;
+  const std::regex shard_pattern(R"((\d+)/(\d+))");
+  if (!std::regex_match(args.shard, match, shard_pattern)) {
+    throw ConfigError(fmt::format("--shard '{}' must look like i/N (for example 0/4)", args.shard));
+  }
+  args.options.shard = std::stoi(match[1]);
+  args.options.shards = std::stoi(match[2]);
+  const auto parent = args.out.parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+    throw FileError(
+        fmt::format("--out '{}': folder '{}' does not exist", args.out.string(), parent.string()));
+  }
+  const int total = static_cast<int>(
+      static_cast<long long>(args.options.count) * (args.options.shard + 1) / args.options.shards -
+      static_cast<long long>(args.options.count) * args.options.shard / args.options.shards);
+  std::atomic<int> done{0};
+  const auto start = std::chrono::steady_clock::now();
+  auto future =
+      std::async(std::launch::async, [&] { return bullet::generate_dataset(args.options, &done); });
+  ProgressBar bar("generate", total);
+  while (future.wait_for(std::chrono::milliseconds(200)) != std::future_status::ready) {
+    bar.update(done);
+  }
+  const std::vector<Trajectory> trajectories = future.get();
+  bar.finish(total);
+  write_trajectories(args.out, trajectories,
+                     {args.options.scene.preset, FIGNET_VERSION, args.options.seed});
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  fmt::print("wrote {} trajectories ({} frames each) to {} in {:.1f} s\n", trajectories.size(),
+             args.options.scene.frames, args.out.string(), seconds);
+}
+
+}  // namespace
+
+void add_generate_command(CLI::App& app) {
+  auto args = std::make_shared<GenerateArgs>();
+  auto* cmd = app.add_subcommand(
+      "generate", "Simulate Kubric-style scenes in Bullet and write a trajectory file");
+  cmd->add_option("--preset", args->options.scene.preset, "Scene preset")
+      ->check(CLI::IsMember(bullet::movi_presets()))
+      ->capture_default_str();
+  cmd->add_option("--count", args->options.count, "Trajectories in the whole dataset")
+      ->check(CLI::Range(1, 10'000'000))
+      ->capture_default_str();
+  cmd->add_option("--seed", args->options.seed,
+                  "Base seed (use different seeds for train/valid/test)")
+      ->capture_default_str();
+  cmd->add_option("--frames", args->options.scene.frames, "Frames per trajectory (48 Hz)")
+      ->check(CLI::Range(2, 100'000))
+      ->capture_default_str();
+  cmd->add_option("--min-objects", args->options.scene.min_objects, "Fewest objects per scene")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  cmd->add_option("--max-objects", args->options.scene.max_objects, "Most objects per scene")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  cmd->add_option("--threads", args->options.threads, "Worker threads (0: every core)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  cmd->add_option("--shard", args->shard, "Write shard i of N (i/N) so machines can split the work")
+      ->capture_default_str();
+  cmd->add_option("--out", args->out, "Output file (.h5), written atomically")->required();
+  cmd->callback([args] { run_generate(*args); });
+}
+
+}  // namespace fignet::cli
