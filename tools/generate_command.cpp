@@ -59,7 +59,7 @@ void run_generate(GenerateArgs args) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   fmt::print("wrote {} trajectories ({} frames each) to {} in {:.1f} s\n", trajectories.size(),
-             args.options.scene.frames, args.out.string(), seconds);
+             trajectories.front().num_frames(), args.out.string(), seconds);
 }
 
 }  // namespace
@@ -77,8 +77,9 @@ void add_generate_command(CLI::App& app) {
   cmd->add_option("--seed", args->options.seed,
                   "Base seed (use different seeds for train/valid/test)")
       ->capture_default_str();
-  cmd->add_option("--frames", args->options.scene.frames, "Frames per trajectory (48 Hz)")
-      ->check(CLI::Range(2, 100'000))
+  cmd->add_option("--frames", args->options.scene.frames,
+                  "Frames per trajectory (0: the preset's, movi-a 96 at 48 Hz, pushing 42)")
+      ->check(CLI::Range(0, 100'000))
       ->capture_default_str();
   cmd->add_option("--min-objects", args->options.scene.min_objects, "Fewest objects per scene")
       ->check(CLI::Range(1, 1000))

@@ -92,7 +92,7 @@ BulletSimulation::BulletSimulation(const SceneSpec& spec, const SolverSettings& 
       hull->addPoint(to_bt(Vec3(body.mesh->vertices().row(v).transpose())), false);
     }
     hull->recalcLocalAabb();
-    hull->setMargin(btScalar(settings.collision_margin));
+    hull->setMargin(btScalar(spec.collision_margin));
     const double mass = body.kinematic ? 0.0 : body.properties.mass;
     btRigidBody* rigid =
         impl_->add(std::move(hull), mass, body.kinematic ? btVector3(0, 0, 0) : to_bt(body.inertia),

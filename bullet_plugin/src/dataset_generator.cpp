@@ -23,7 +23,7 @@ std::vector<Trajectory> generate_dataset(const GenerateOptions& options, std::at
     throw ConfigError(fmt::format("shard {}/{} is not one of 0..{} of {}", options.shard,
                                   options.shards, options.shards - 1, options.shards));
   }
-  sample_movi_scene(options.scene, 0);  // validates the scene options before any thread starts
+  sample_scene(options.scene, 0);  // validates the scene options before any thread starts
   const int begin =
       static_cast<int>(static_cast<long long>(options.count) * options.shard / options.shards);
   const int end = static_cast<int>(static_cast<long long>(options.count) * (options.shard + 1) /
@@ -38,7 +38,7 @@ std::vector<Trajectory> generate_dataset(const GenerateOptions& options, std::at
   auto work = [&] {
     for (int i = next++; i < end; i = next++) {
       try {
-        const SceneSpec spec = sample_movi_scene(options.scene, trajectory_seed(options.seed, i));
+        const SceneSpec spec = sample_scene(options.scene, trajectory_seed(options.seed, i));
         BulletSimulation simulation(spec, options.solver);
         result[i - begin] = simulation.record();
       } catch (...) {

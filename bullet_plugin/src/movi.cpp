@@ -41,8 +41,13 @@ const BodySpec& body_template(const std::string& shape, double scale, const Mate
 }  // namespace
 
 const std::vector<std::string>& movi_presets() {
-  static const std::vector<std::string> presets = {"movi-a"};
+  static const std::vector<std::string> presets = {"movi-a", "pushing"};
   return presets;
+}
+
+SceneSpec sample_scene(const MoviOptions& options, std::uint64_t seed) {
+  if (options.preset == "pushing") return sample_pushing_scene(options, seed);
+  return sample_movi_scene(options, seed);
 }
 
 SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {

@@ -104,6 +104,33 @@ TEST(Generator, ScenesStartWithoutOverlapAndStayAboveTheFloor) {
   }
 }
 
+TEST(Generator, PusherFollowsItsScriptedPathExactly) {
+  GenerateOptions options;
+  options.scene.preset = "pushing";
+  options.count = 10;
+  options.seed = 4;
+  int moved = 0;
+  for (const Trajectory& t : generate_dataset(options)) {
+    ASSERT_EQ(t.num_frames(), 42);
+    EXPECT_NEAR(t.time_step, 3.0 / 250.0, 1e-15);
+    const SceneSpec spec = sample_pushing_scene(options.scene, t.seed);
+    const TrajectoryObject& pusher = t.objects[1];
+    ASSERT_TRUE(pusher.kinematic);
+    EXPECT_EQ(pusher.properties.mass, 0.0);
+    for (int f = 0; f < t.num_frames(); ++f) {
+      const Vec3 scripted =
+          spec.bodies[1].pose.position + spec.bodies[1].linear_velocity * f * t.time_step;
+      EXPECT_LT((pusher.poses[f].position - scripted).norm(), 1e-6)
+          << "frame " << f;  // float32 Bullet
+    }
+    // The object starts at rest on the plane and ends up pushed in most scenes.
+    const TrajectoryObject& object = t.objects[0];
+    EXPECT_FALSE(object.kinematic);
+    moved += (object.poses.back().position - object.poses.front().position).norm() > 1e-3;
+  }
+  EXPECT_GE(moved, 5);
+}
+
 TEST(Generator, BadOptionsAreConfigErrors) {
   GenerateOptions options = small_options(1);
   options.shard = 2;

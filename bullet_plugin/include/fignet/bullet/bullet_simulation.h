@@ -19,7 +19,6 @@ struct SolverSettings {
   bool warm_starting = false;
   double restitution_velocity_threshold = 0.0;
   double linear_slop = 0.0;
-  double collision_margin = 0.005;  // metres, convex hulls; small so shapes match their meshes
 };
 
 class BulletSimulation {

@@ -11,9 +11,9 @@
 namespace fignet::bullet {
 
 struct MoviOptions {
-  std::string preset = "movi-a";  // only "movi-a" so far
+  std::string preset = "movi-a";  // "movi-a" or "pushing"
   int min_objects = 3, max_objects = 10;
-  int frames = 96;
+  int frames = 0;  // 0: the preset's own (movi-a 96, pushing 42)
 };
 
 // The scene of `seed`: 3–10 objects from {cube, cylinder, sphere}, scale 0.7 or 1.4, metal
@@ -25,6 +25,15 @@ struct MoviOptions {
 // option.
 SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed);
 
+// The MIT-pushing stand-in (seed B.2, facts §2) of `seed`: a planar prism (rectangle, triangle,
+// ellipse or hexagon, 4–8 cm across, 2 cm thick, 1000 kg/m³, friction 0.25) resting on a support
+// plane (friction 0.25), and a kinematic cylindrical pusher (radius 5 mm, mass 0, its nodes
+// kinematic) moving at a constant 5–15 cm/s toward a random point of the prism's side, at a random
+// angle within ±30° of the side's normal. Bullet at 250 Hz, 125 steps recorded every 3 (42 frames).
+SceneSpec sample_pushing_scene(const MoviOptions& options, std::uint64_t seed);
+
+// Dispatches on options.preset; throws ConfigError naming the valid presets.
+SceneSpec sample_scene(const MoviOptions& options, std::uint64_t seed);
 const std::vector<std::string>& movi_presets();
 
 }  // namespace fignet::bullet

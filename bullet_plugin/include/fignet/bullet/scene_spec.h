@@ -30,6 +30,7 @@ struct SceneSpec {
   int steps_per_frame = 5;            // 240 Hz / 5 = 48 Hz frames
   int frames = 96;
   std::uint64_t seed = 0;
+  double collision_margin = 0.005;  // metres around convex hulls (small scenes need less)
 
   double frame_step() const { return physics_step * steps_per_frame; }
 };
