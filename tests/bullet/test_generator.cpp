@@ -92,8 +92,7 @@ TEST(Generator, ScenesStartWithoutOverlapAndStayAboveTheFloor) {
     finder.update(meshes, false);
     std::vector<ObjectPair> pairs;
     std::vector<FacePair> touching;
-    finder.find_candidate_pairs(0.0, pairs);
-    finder.find_face_pairs(pairs, 0.0, touching);
+    finder.find_all_face_pairs(0.0, pairs, touching);
     EXPECT_TRUE(touching.empty()) << "seed " << t.seed;
     // Every frame: every vertex above the floor, within Bullet's contact tolerance.
     for (const auto& object : t.objects) {

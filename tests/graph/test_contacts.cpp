@@ -52,8 +52,7 @@ std::set<Key> brute_force_faces(const std::vector<PosedMesh>& posed, double radi
 std::set<Key> query_face_pairs(ContactFinder& finder, double radius) {
   std::vector<ObjectPair> candidates;
   std::vector<FacePair> found;
-  finder.find_candidate_pairs(radius, candidates);
-  finder.find_face_pairs(candidates, radius, found);
+  finder.find_all_face_pairs(radius, candidates, found);
   std::set<Key> keys;
   for (const FacePair& p : found) {
     EXPECT_TRUE(keys.insert({p.object_a, p.face_a, p.object_b, p.face_b}).second);

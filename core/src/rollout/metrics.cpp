@@ -94,8 +94,7 @@ Penetration measure_penetration(const Trajectory& trajectory, int frame) {
   finder.update(meshes, false);
   std::vector<ObjectPair> pairs;
   std::vector<FacePair> faces;
-  finder.find_candidate_pairs(0.0, pairs);
-  finder.find_face_pairs(pairs, 0.0, faces);
+  finder.find_all_face_pairs(0.0, pairs, faces);
   result.intersecting_face_pairs = static_cast<int>(faces.size());
   // Depth of every vertex inside another object of an overlapping pair.
   for (const ObjectPair& pair : pairs) {

@@ -50,6 +50,14 @@ class ContactFinder {
   // Every pair of faces of the candidate objects within `radius`, with exact closest points.
   void find_face_pairs(std::span<const ObjectPair> candidates, double radius,
                        std::vector<FacePair>& out) const;
+  // Both phases at once: the candidate pairs (kept in `pairs`) and their face pairs within
+  // `radius`.
+  void find_all_face_pairs(double radius, std::vector<ObjectPair>& pairs,
+                           std::vector<FacePair>& out) {
+    find_candidate_pairs(radius, pairs);
+    find_face_pairs(pairs, radius, out);
+  }
+
   // Every pair of nodes of the candidate objects within `radius`.
   void find_node_pairs(std::span<const ObjectPair> candidates, double radius,
                        std::vector<NodePair>& out) const;
