@@ -44,6 +44,30 @@ Pose scripted_pose(const BodySpec& body, double seconds) {
 }  // namespace
 
 struct BulletSimulation::Impl {
+  // Compound children are owned here (a compound does not own them).
+  std::vector<std::unique_ptr<btCollisionShape>> child_shapes;
+
+  std::unique_ptr<btConvexHullShape> make_hull(const Points& points, double margin) {
+    auto hull = std::make_unique<btConvexHullShape>();
+    for (Eigen::Index v = 0; v < points.rows(); ++v) {
+      hull->addPoint(to_bt(Vec3(points.row(v).transpose())), false);
+    }
+    hull->recalcLocalAabb();
+    hull->setMargin(btScalar(margin));
+    return hull;
+  }
+
+  // A convex hull of the mesh, or a compound of the hulls of its convex parts.
+  std::unique_ptr<btCollisionShape> make_shape(const BodySpec& body, double margin) {
+    if (body.convex_parts.empty()) return make_hull(body.mesh->vertices(), margin);
+    auto compound = std::make_unique<btCompoundShape>();
+    for (const Points& part : body.convex_parts) {
+      child_shapes.push_back(make_hull(part, margin));
+      compound->addChildShape(btTransform::getIdentity(), child_shapes.back().get());
+    }
+    return compound;
+  }
+
   SceneSpec spec;
   btDefaultCollisionConfiguration configuration;
   btCollisionDispatcher dispatcher{&configuration};
@@ -87,16 +111,10 @@ BulletSimulation::BulletSimulation(const SceneSpec& spec, const SolverSettings& 
   for (size_t i = 0; i < spec.bodies.size(); ++i) {
     const BodySpec& body = spec.bodies[i];
     if (!body.mesh) throw ConfigError("bullet scene: body " + std::to_string(i) + " has no mesh");
-    auto hull = std::make_unique<btConvexHullShape>();
-    for (Eigen::Index v = 0; v < body.mesh->num_vertices(); ++v) {
-      hull->addPoint(to_bt(Vec3(body.mesh->vertices().row(v).transpose())), false);
-    }
-    hull->recalcLocalAabb();
-    hull->setMargin(btScalar(spec.collision_margin));
     const double mass = body.kinematic ? 0.0 : body.properties.mass;
     btRigidBody* rigid =
-        impl_->add(std::move(hull), mass, body.kinematic ? btVector3(0, 0, 0) : to_bt(body.inertia),
-                   to_bt(body.pose));
+        impl_->add(impl_->make_shape(body, spec.collision_margin), mass,
+                   body.kinematic ? btVector3(0, 0, 0) : to_bt(body.inertia), to_bt(body.pose));
     rigid->setFriction(btScalar(body.properties.friction));
     rigid->setRestitution(btScalar(body.properties.restitution));
     rigid->setActivationState(DISABLE_DEACTIVATION);  // datasets record every body every frame

@@ -20,28 +20,37 @@ struct Material {
 constexpr Material kMetal{0.4, 0.3, 2.7};
 constexpr Material kRubber{0.8, 0.7, 1.1};
 
-// One body template per (shape, scale, material), shared by every scene of the process.
-const BodySpec& body_template(const std::string& shape, double scale, const Material& material) {
+// One unit-scale body per (shape, material), shared by every scene of the process.
+const BodySpec& unit_body(const std::string& shape, const Material& material) {
   static std::mutex mutex;
-  static std::map<std::tuple<std::string, double, double>, BodySpec> cache;
+  static std::map<std::pair<std::string, double>, BodySpec> cache;
   const std::lock_guard lock(mutex);
-  const auto key = std::tuple(shape, scale, material.density);
-  auto it = cache.find(key);
+  auto it = cache.find({shape, material.density});
   if (it == cache.end()) {
-    const TriangleMesh unit = make_movi_shape(shape);
-    const TriangleMesh scaled(shape, unit.vertices() * scale, unit.faces());
     it = cache
-             .emplace(key,
-                      make_body(scaled, material.density, material.friction, material.restitution))
+             .emplace(std::pair(shape, material.density),
+                      make_body(make_movi_shape(shape), material.density, material.friction,
+                                material.restitution, movi_convex_parts(shape)))
              .first;
   }
   return it->second;
 }
 
+// The unit body scaled by s: lengths × s, mass × s³, inertia × s⁵.
+BodySpec scaled_body(const BodySpec& unit, double s) {
+  BodySpec body = unit;
+  body.mesh = std::make_shared<const TriangleMesh>(unit.mesh->name(), unit.mesh->vertices() * s,
+                                                   unit.mesh->faces());
+  for (Points& part : body.convex_parts) part *= s;
+  body.properties.mass *= s * s * s;
+  body.inertia *= s * s * s * s * s;
+  return body;
+}
+
 }  // namespace
 
 const std::vector<std::string>& movi_presets() {
-  static const std::vector<std::string> presets = {"movi-a", "pushing"};
+  static const std::vector<std::string> presets = {"movi-a", "movi-b", "pushing"};
   return presets;
 }
 
@@ -51,7 +60,8 @@ SceneSpec sample_scene(const MoviOptions& options, std::uint64_t seed) {
 }
 
 SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
-  if (options.preset != "movi-a") {
+  const bool movi_b = options.preset == "movi-b";
+  if (options.preset != "movi-a" && !movi_b) {
     throw ConfigError(fmt::format("unknown scene preset '{}'; available: {}", options.preset,
                                   fmt::join(movi_presets(), ", ")));
   }
@@ -69,13 +79,17 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> normal;
-  const char* shapes[] = {"cube", "cylinder", "sphere"};
+  // MOVi-A: cube, cylinder, sphere at scale 0.7 or 1.4; MOVi-B: all eight shapes, scale
+  // U(0.7, 1.4).
+  const std::vector<std::string>& all_shapes = movi_shape_names();
+  const int shape_count = movi_b ? static_cast<int>(all_shapes.size()) : 3;
   const int count = options.min_objects +
                     static_cast<int>(unit(rng) * (options.max_objects - options.min_objects + 1));
   std::vector<std::pair<Vec3, double>> spheres;  // placed bodies' bounding spheres
   for (int i = 0; i < std::min(count, options.max_objects); ++i) {
-    BodySpec body = body_template(shapes[static_cast<int>(unit(rng) * 3) % 3],
-                                  unit(rng) < 0.5 ? 0.7 : 1.4, unit(rng) < 0.5 ? kMetal : kRubber);
+    const std::string& shape = all_shapes[static_cast<int>(unit(rng) * shape_count) % shape_count];
+    const double scale = movi_b ? 0.7 + 0.7 * unit(rng) : (unit(rng) < 0.5 ? 0.7 : 1.4);
+    BodySpec body = scaled_body(unit_body(shape, unit(rng) < 0.5 ? kMetal : kRubber), scale);
     const double radius = body.mesh->vertices().rowwise().norm().maxCoeff();
     bool placed = false;
     for (int attempt = 0; attempt < 100 && !placed; ++attempt) {

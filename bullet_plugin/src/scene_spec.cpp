@@ -6,7 +6,8 @@
 
 namespace fignet::bullet {
 
-BodySpec make_body(const TriangleMesh& mesh, double density, double friction, double restitution) {
+BodySpec make_body(const TriangleMesh& mesh, double density, double friction, double restitution,
+                   const std::vector<Points>& convex_parts) {
   const MassProperties props = compute_mass_properties(mesh);
   // Principal axes: the eigenvectors of the inertia tensor, as a proper rotation.
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(props.inertia);
@@ -23,6 +24,11 @@ BodySpec make_body(const TriangleMesh& mesh, double density, double friction, do
   body.mesh = std::make_shared<const TriangleMesh>(mesh.name(), std::move(vertices), mesh.faces());
   body.properties = {density * props.volume, friction, restitution};
   body.inertia = density * (axes.transpose() * props.inertia * axes).diagonal();
+  if (convex_parts.size() > 1) {
+    for (const Points& part : convex_parts) {
+      body.convex_parts.push_back((part.rowwise() - props.center_of_mass.transpose()) * axes);
+    }
+  }
   return body;
 }
 

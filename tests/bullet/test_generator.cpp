@@ -1,8 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include "fignet/bullet/dataset_generator.h"
 #include "fignet/error.h"
 #include "fignet/geometry/mass_properties.h"
+#include "fignet/geometry/shapes.h"
 #include "fignet/graph/contacts.h"
 
 namespace fignet::bullet {
@@ -94,10 +97,11 @@ TEST(Generator, ScenesStartWithoutOverlapAndStayAboveTheFloor) {
     std::vector<FacePair> touching;
     finder.find_all_face_pairs(0.0, pairs, touching);
     EXPECT_TRUE(touching.empty()) << "seed " << t.seed;
-    // Every frame: every vertex above the floor, within Bullet's contact tolerance.
+    // Every frame: every vertex above the floor, up to Bullet's transient contact penetration,
+    // which is at most one step of travel at impact: a 5 m drop lands at 10 m/s, 10/240 = 4.2 cm.
     for (const auto& object : t.objects) {
       for (const Pose& pose : object.poses) {
-        EXPECT_GE(posed_vertices(*object.mesh, pose).col(2).minCoeff(), -0.03) << "seed " << t.seed;
+        EXPECT_GE(posed_vertices(*object.mesh, pose).col(2).minCoeff(), -0.05) << "seed " << t.seed;
       }
     }
   }
@@ -128,6 +132,45 @@ TEST(Generator, PusherFollowsItsScriptedPathExactly) {
     moved += (object.poses.back().position - object.poses.front().position).norm() > 1e-3;
   }
   EXPECT_GE(moved, 5);
+}
+
+TEST(NonConvexBodies, ATorusHangsOnAPeg) {
+  // A horizontal peg (a 10 cm square bar along x, top at z = 2.05) through the hole of a torus
+  // (R = 0.7, r = 0.3) whose axis is along x. Hanging, the ring's inner surface rests on the peg:
+  // centre at 2.05 − (R − r) = 1.65. A convex hull would fill the hole and throw the torus off.
+  SceneSpec spec;
+  spec.frames = 96;
+  spec.floor = Floor{};
+  BodySpec peg = make_body(make_box(Vec3(1.0, 0.05, 0.05), 1), 1.0, 0.5, 0.0);
+  peg.kinematic = true;
+  peg.pose.position = Vec3(0, 0, 2.0);
+  BodySpec torus = make_body(make_movi_shape("torus"), 1.0, 0.5, 0.0, movi_convex_parts("torus"));
+  ASSERT_EQ(torus.convex_parts.size(), 32u);
+  torus.pose.orientation = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY());  // axis z -> x
+  torus.pose.position = Vec3(0, 0, 1.7);
+  spec.bodies = {peg, torus};
+  BulletSimulation simulation(spec);
+  const Trajectory t = simulation.record();
+  const Vec3 end = t.objects[1].poses.back().position;
+  EXPECT_NEAR(end.z(), 1.65, 0.05) << "the torus fell off or rests on top of the peg";
+  EXPECT_NEAR(end.y(), 0.0, 0.05);
+}
+
+TEST(Generator, MoviBUsesEveryShapeAtContinuousScales) {
+  std::set<std::string> names;
+  for (std::uint64_t seed = 0; seed < 40; ++seed) {
+    MoviOptions options;
+    options.preset = "movi-b";
+    for (const BodySpec& body : sample_scene(options, trajectory_seed(9, seed)).bodies) {
+      names.insert(body.mesh->name());
+      const bool convex = body.convex_parts.empty();
+      const std::string& name = body.mesh->name();
+      EXPECT_EQ(convex,
+                name != "torus" && name != "torus_knot" && name != "gear" && name != "sponge")
+          << name;
+    }
+  }
+  EXPECT_EQ(names.size(), movi_shape_names().size());
 }
 
 TEST(Generator, BadOptionsAreConfigErrors) {

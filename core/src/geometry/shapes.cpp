@@ -320,4 +320,65 @@ TriangleMesh make_movi_shape(std::string_view name) {
                                 fmt::join(movi_shape_names(), ", ")));
 }
 
+namespace {
+
+// Vertices of rows [a·m, (a+1)·m) and [b·m, (b+1)·m) of a periodic grid mesh.
+Points ring_pair(const Points& vertices, int m, int a, int b) {
+  Points part(2 * m, 3);
+  part.topRows(m) = vertices.middleRows(static_cast<Eigen::Index>(a) * m, m);
+  part.bottomRows(m) = vertices.middleRows(static_cast<Eigen::Index>(b) * m, m);
+  return part;
+}
+
+}  // namespace
+
+std::vector<Points> movi_convex_parts(std::string_view name) {
+  const TriangleMesh mesh = make_movi_shape(name);
+  const Points& v = mesh.vertices();
+  std::vector<Points> parts;
+  if (name == "torus" || name == "torus_knot") {
+    // periodic_grid layout: vertex i·m + j; the defaults of make_torus / make_torus_knot.
+    const int n = name == "torus" ? 32 : 120, m = name == "torus" ? 12 : 8;
+    for (int i = 0; i < n; ++i) parts.push_back(ring_pair(v, m, i, (i + 1) % n));
+  } else if (name == "gear") {
+    // make_prism layout: bottom ring [0, P), top ring [P, 2P); 4 outline points per tooth:
+    // root, tip, tip, root.
+    const int p = (mesh.num_vertices() - 2) / 2, teeth = p / 4;
+    std::vector<Eigen::Index> roots;
+    for (int k = 0; k < teeth; ++k) roots.insert(roots.end(), {4 * k, 4 * k + 3});
+    Points core(2 * roots.size(), 3);
+    for (size_t r = 0; r < roots.size(); ++r) {
+      core.row(2 * r) = v.row(roots[r]);
+      core.row(2 * r + 1) = v.row(roots[r] + p);
+    }
+    parts.push_back(core);
+    for (int k = 0; k < teeth; ++k) {
+      Points tooth(8, 3);
+      for (int s = 0; s < 4; ++s) {
+        tooth.row(2 * s) = v.row(4 * k + s);
+        tooth.row(2 * s + 1) = v.row(4 * k + s + p);
+      }
+      parts.push_back(tooth);
+    }
+  } else if (name == "sponge") {
+    // make_menger_sponge(1.0, 1): the 20 kept cells of the 3×3×3 grid over [-1, 1]^3.
+    for (int x = 0; x < 3; ++x) {
+      for (int y = 0; y < 3; ++y) {
+        for (int z = 0; z < 3; ++z) {
+          if ((x == 1) + (y == 1) + (z == 1) >= 2) continue;
+          Points cell(8, 3);
+          for (int c = 0; c < 8; ++c) {
+            cell.row(c) << -1 + 2.0 / 3 * (x + (c & 1)), -1 + 2.0 / 3 * (y + ((c >> 1) & 1)),
+                -1 + 2.0 / 3 * (z + ((c >> 2) & 1));
+          }
+          parts.push_back(cell);
+        }
+      }
+    }
+  } else {
+    parts.push_back(v);  // convex: cube, cylinder, sphere, cone
+  }
+  return parts;
+}
+
 }  // namespace fignet

@@ -11,7 +11,7 @@
 namespace fignet::bullet {
 
 struct MoviOptions {
-  std::string preset = "movi-a";  // "movi-a" or "pushing"
+  std::string preset = "movi-a";  // "movi-a", "movi-b" or "pushing"
   int min_objects = 3, max_objects = 10;
   int frames = 0;  // 0: the preset's own (movi-a 96, pushing 42)
 };
@@ -21,8 +21,9 @@ struct MoviOptions {
 // positions uniform in (−5,−5,1)–(5,5,5) resampled (≤ 100 tries) until the object's bounding
 // sphere overlaps no earlier one and its lowest point is above the floor, and a horizontal
 // velocity uniform in (−4,−4,0)–(4,4,0) minus the spawn point's (x, y, 0): tossed toward the
-// centre. Floor friction 0.3, restitution 0.5; gravity (0, 0, −10). Throws ConfigError for a bad
-// option.
+// centre. Floor friction 0.3, restitution 0.5; gravity (0, 0, −10). "movi-b" draws from all eight
+// MOVi shapes (non-convex ones as compounds of their exact convex parts) with scale uniform in
+// 0.7–1.4. Throws ConfigError for a bad option.
 SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed);
 
 // The MIT-pushing stand-in (seed B.2, facts §2) of `seed`: a planar prism (rectangle, triangle,

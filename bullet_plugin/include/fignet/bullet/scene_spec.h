@@ -14,7 +14,9 @@
 namespace fignet::bullet {
 
 struct BodySpec {
-  std::shared_ptr<const TriangleMesh> mesh;           // principal centre-of-mass frame
+  std::shared_ptr<const TriangleMesh> mesh;  // principal centre-of-mass frame
+  // Convex pieces whose union is the body (same frame); empty: the mesh is convex.
+  std::vector<Points> convex_parts;
   StaticProperties properties;                        // mass = density × volume (0 when kinematic)
   Eigen::Vector3d inertia = Eigen::Vector3d::Ones();  // principal moments, kg·m²
   bool kinematic = false;
@@ -37,6 +39,8 @@ struct SceneSpec {
 
 // A body of `density` made from `mesh` in any frame: the mesh is moved to its principal
 // centre-of-mass frame (Bullet needs a diagonal inertia) and `pose` is the pose of that frame.
-BodySpec make_body(const TriangleMesh& mesh, double density, double friction, double restitution);
+// `convex_parts` (in the mesh's frame) describe a non-convex mesh as a union of convex pieces.
+BodySpec make_body(const TriangleMesh& mesh, double density, double friction, double restitution,
+                   const std::vector<Points>& convex_parts = {});
 
 }  // namespace fignet::bullet

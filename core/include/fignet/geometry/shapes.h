@@ -45,4 +45,11 @@ const std::vector<std::string>& movi_shape_names();
 // The unit MOVi shape called `name` (throws ConfigError naming the valid names otherwise).
 TriangleMesh make_movi_shape(std::string_view name);
 
+// An exact decomposition of make_movi_shape(name) into convex pieces, each given by its vertices
+// (a subset of the mesh's, or for the sponge its voxel corners), in the mesh's frame: one piece for
+// the convex shapes; consecutive ring pairs of the torus and torus knot tubes; the root polygon and
+// one quadrilateral prism per tooth of the gear; the 20 cubes of the sponge. Physics engines
+// collide the union of the pieces' convex hulls, so a torus can hang on a peg.
+std::vector<Points> movi_convex_parts(std::string_view name);
+
 }  // namespace fignet
