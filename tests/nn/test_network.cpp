@@ -73,15 +73,7 @@ TEST_P(NetworkGradient, MatchesFiniteDifferences) {
     ASSERT_GT(graph.world_edges.size(), 0);
   }
   Normalizers normalizers = network.make_normalizers();
-  normalizers.mesh_node.accumulate(graph.mesh_nodes.matrix());
-  normalizers.object_node.accumulate(graph.object_nodes.matrix());
-  normalizers.face_edge.accumulate(graph.face_edges.features.matrix());
-  for (size_t t = 0; t < network.edge_kinds().size(); ++t) {
-    const EdgeSet* sets[] = {&graph.mesh_edges, &graph.object_to_mesh, &graph.mesh_to_object,
-                             &graph.world_edges};
-    normalizers.edges[t].accumulate(
-        sets[static_cast<int>(network.edge_kinds()[t])]->features.matrix());
-  }
+  network.accumulate_input_statistics(graph, normalizers);
   std::mt19937 rng(3);
   std::normal_distribution<float> n;
   RowMatrixXf weights(graph.num_mesh_nodes(), 3);

@@ -14,14 +14,16 @@ constexpr const char* kFormat = "fignet-model";
 constexpr const char* kWhat = "model file";
 
 // Normalisers by stable name: "mesh_node", "object_node", "face_edge", "target", "edge_<kind>".
-std::vector<std::pair<std::string, Normalizer*>> named(Normalizers& n, const Network& network) {
-  const char* kinds[] = {"mesh_edge", "object_to_mesh", "mesh_to_object", "world_edge"};
-  std::vector<std::pair<std::string, Normalizer*>> result = {{"mesh_node", &n.mesh_node},
-                                                             {"object_node", &n.object_node},
-                                                             {"face_edge", &n.face_edge},
-                                                             {"target", &n.target}};
+// `N` is Normalizers or const Normalizers: saving reads them, loading fills them.
+template <class N>
+auto named(N& n, const Network& network) {
+  using Pointer = decltype(&n.mesh_node);
+  std::vector<std::pair<std::string, Pointer>> result = {{"mesh_node", &n.mesh_node},
+                                                         {"object_node", &n.object_node},
+                                                         {"face_edge", &n.face_edge},
+                                                         {"target", &n.target}};
   for (size_t t = 0; t < network.edge_kinds().size(); ++t) {
-    result.emplace_back(std::string("edge_") + kinds[static_cast<int>(network.edge_kinds()[t])],
+    result.emplace_back(std::string("edge_") + edge_kind_name(network.edge_kinds()[t]),
                         &n.edges[t]);
   }
   return result;
@@ -99,8 +101,7 @@ void save_model(const Model& model, const std::filesystem::path& path) {
                          {static_cast<hsize_t>(t.rows), static_cast<hsize_t>(t.cols)});
     }
     H5::Group normalizers = file.createGroup("normalizers");
-    Normalizers copy = model.normalizers();
-    for (auto& [name, normalizer] : named(copy, model.network())) {
+    for (const auto& [name, normalizer] : named(model.normalizers(), model.network())) {
       H5::Group group = normalizers.createGroup(name);
       hdf5::write_attribute(group, "accumulations",
                             static_cast<long long>(normalizer->accumulations()));

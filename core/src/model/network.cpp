@@ -46,6 +46,20 @@ NetworkWorkspace::~NetworkWorkspace() = default;
 NetworkWorkspace::NetworkWorkspace(NetworkWorkspace&&) noexcept = default;
 NetworkWorkspace& NetworkWorkspace::operator=(NetworkWorkspace&&) noexcept = default;
 
+const char* edge_kind_name(EdgeKind kind) {
+  switch (kind) {
+    case EdgeKind::kMesh:
+      return "mesh_edge";
+    case EdgeKind::kObjectToMesh:
+      return "object_to_mesh";
+    case EdgeKind::kMeshToObject:
+      return "mesh_to_object";
+    case EdgeKind::kWorld:
+      return "world_edge";
+  }
+  return "unknown";
+}
+
 Network::~Network() = default;
 
 Network::Network(const ModelConfig& config)
@@ -60,8 +74,7 @@ Network::Network(const ModelConfig& config)
   if (!face_edges_) edge_kinds_.push_back(EdgeKind::kWorld);
 
   const int l = config_.latent_size;
-  const char* kind_names[] = {"mesh_edge", "object_to_mesh", "mesh_to_object", "world_edge"};
-  auto name_of = [&](int t) { return std::string(kind_names[static_cast<int>(edge_kinds_[t])]); };
+  auto name_of = [&](int t) { return std::string(edge_kind_name(edge_kinds_[t])); };
   // Encoders (seed C.1.1).
   encode_mesh_node_ = Mlp(layout_, "encoder/mesh_node", {sizes_.mesh_node}, l, l, true);
   if (config_.graph.object_nodes) {
@@ -108,6 +121,15 @@ Normalizers Network::make_normalizers() const {
     n.edges.emplace_back(kind == EdgeKind::kWorld ? sizes_.world_edge : sizes_.mesh_edge, max);
   }
   return n;
+}
+
+void Network::accumulate_input_statistics(const Graph& graph, Normalizers& normalizers) const {
+  normalizers.mesh_node.accumulate(graph.mesh_nodes.matrix());
+  normalizers.object_node.accumulate(graph.object_nodes.matrix());
+  normalizers.face_edge.accumulate(graph.face_edges.features.matrix());
+  for (int t = 0; t < static_cast<int>(edge_kinds_.size()); ++t) {
+    normalizers.edges[t].accumulate(edges_of(graph, t).features.matrix());
+  }
 }
 
 const EdgeSet& Network::edges_of(const Graph& graph, int kind) const {
@@ -306,7 +328,6 @@ void Network::backward(const float* params, float* grads, const Graph& graph,
   for (int k = m - 1; k >= 0; --k) {
     const Step& step = steps_[k];
     Level& cur = ws.levels[k];
-    Level& next = ws.levels[k + 1];
     StepCache& c = ws.steps[k];
     // Residuals pass node gradients straight through.
     g_cur->mesh.view(nodes, l) = g_next->mesh.get();
@@ -386,7 +407,6 @@ void Network::backward(const float* params, float* grads, const Graph& graph,
                                   ws.scratch);
       }
     }
-    (void)next;
     std::swap(g_next, g_cur);
   }
 

@@ -6,8 +6,8 @@ namespace fignet {
 
 namespace {
 
-Pose pose_of_centers(const SceneObject& object) {
-  // A kinematic object's next pose is recovered from its next node positions.
+// A kinematic object's next pose, recovered from its given next node positions.
+Pose next_kinematic_pose(const SceneObject& object) {
   return fit_rigid_transform(object.mesh->vertices(), object.next_positions);
 }
 
@@ -23,7 +23,7 @@ void predict_next_poses(AccelerationPredictor& predictor, const Scene& scene,
     const int v = object.mesh->num_vertices();
     const int steps = object.num_steps();
     if (object.kinematic) {
-      next[o] = pose_of_centers(object);
+      next[o] = next_kinematic_pose(object);
     } else {
       // Finite-difference integration of each node, then the closest rigid motion.
       workspace.predicted = workspace.accelerations.middleRows(row, v) +

@@ -51,15 +51,7 @@ void Trainer::prepare_batch(const std::vector<SampleRef>& batch, bool accumulate
   gather_targets(graph_, scene_targets_, targets_, in_loss_);
   if (!accumulate) return;
   // Statistics of every input block and of the dynamic nodes' targets (MeshGraphNets style).
-  normalizers_.mesh_node.accumulate(graph_.mesh_nodes.matrix());
-  normalizers_.object_node.accumulate(graph_.object_nodes.matrix());
-  normalizers_.face_edge.accumulate(graph_.face_edges.features.matrix());
-  const EdgeSet* sets[] = {&graph_.mesh_edges, &graph_.object_to_mesh, &graph_.mesh_to_object,
-                           &graph_.world_edges};
-  for (size_t t = 0; t < network_.edge_kinds().size(); ++t) {
-    normalizers_.edges[t].accumulate(
-        sets[static_cast<int>(network_.edge_kinds()[t])]->features.matrix());
-  }
+  network_.accumulate_input_statistics(graph_, normalizers_);
   RowMatrixXf dynamic_targets(std::count(in_loss_.begin(), in_loss_.end(), 1), 3);
   for (Eigen::Index i = 0, r = 0; i < targets_.rows(); ++i) {
     if (in_loss_[i]) dynamic_targets.row(r++) = targets_.row(i);

@@ -4,13 +4,12 @@
 // nothing.
 #pragma once
 
-#include <Eigen/Core>
 #include <cstdint>
 #include <vector>
 
-namespace fignet {
+#include "fignet/geometry/types.h"
 
-using RowMatrixXf = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+namespace fignet {
 
 // A row-major float matrix that grows by rows and keeps its capacity when cleared.
 class FeatureMatrix {
@@ -33,7 +32,7 @@ class FeatureMatrix {
   Eigen::Map<RowMatrixXf> matrix() { return {data_.data(), rows_, cols_}; }
 
  private:
-  std::vector<float, Eigen::aligned_allocator<float>> data_;
+  AlignedFloats data_;
   int rows_ = 0, cols_ = 0;
 };
 

@@ -19,6 +19,10 @@ namespace fignet {
 enum class EdgeKind { kMesh, kObjectToMesh, kMeshToObject, kWorld };
 enum class NodeSet { kMesh = 0, kObject = 1 };
 
+// Stable name of an edge kind, used in parameter and normaliser names of model files:
+// "mesh_edge", "object_to_mesh", "mesh_to_object", "world_edge".
+const char* edge_kind_name(EdgeKind kind);
+
 // Input statistics of every node and edge type, and of the target acceleration.
 struct Normalizers {
   Normalizer mesh_node, object_node, face_edge, target;
@@ -49,6 +53,9 @@ class Network {
   const ParameterLayout& layout() const { return layout_; }
   const std::vector<EdgeKind>& edge_kinds() const { return edge_kinds_; }
   Normalizers make_normalizers() const;
+  // Adds the graph's input features, block by block, to the statistics (the target is the
+  // caller's: only it knows which nodes count).
+  void accumulate_input_statistics(const Graph& graph, Normalizers& normalizers) const;
 
   // Normalised accelerations of every mesh node (rows x 3) for `graph`. With keep_for_backward,
   // every level's activations stay in the workspace for backward().

@@ -2,22 +2,17 @@
 // so per-step activations of graphs of varying size allocate only while they grow.
 #pragma once
 
-#include <Eigen/Core>
 #include <vector>
+
+#include "fignet/geometry/types.h"
 
 namespace fignet {
 
-using RowMatrixXf = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 using MatrixView = Eigen::Map<RowMatrixXf>;
 using ConstMatrixView = Eigen::Map<const RowMatrixXf>;
 // Any row-major float matrix or block of one (a column range of a wider matrix included).
 using MatrixRef = Eigen::Ref<RowMatrixXf, 0, Eigen::OuterStride<>>;
 using ConstMatrixRef = Eigen::Ref<const RowMatrixXf, 0, Eigen::OuterStride<>>;
-
-// Storage aligned for SIMD: Eigen's vectorised reductions peel scalars until the data is aligned,
-// so an address-dependent alignment would change the summation order and break bit-exact
-// determinism between runs and between two trainers in one process.
-using AlignedFloats = std::vector<float, Eigen::aligned_allocator<float>>;
 
 class Buffer {
  public:
