@@ -54,6 +54,13 @@ const std::vector<std::string>& movi_presets() {
   return presets;
 }
 
+int frames_or_default(const MoviOptions& options, int preset_frames) {
+  if (options.frames != 0 && options.frames < 2) {
+    throw ConfigError(fmt::format("frames = {} (needs >= 2)", options.frames));
+  }
+  return options.frames ? options.frames : preset_frames;
+}
+
 SceneSpec sample_scene(const MoviOptions& options, std::uint64_t seed) {
   if (options.preset == "pushing") return sample_pushing_scene(options, seed);
   return sample_movi_scene(options, seed);
@@ -69,12 +76,9 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
     throw ConfigError(fmt::format("objects range {}..{} is empty or below 1", options.min_objects,
                                   options.max_objects));
   }
-  if (options.frames != 0 && options.frames < 2) {
-    throw ConfigError(fmt::format("frames = {} (needs >= 2)", options.frames));
-  }
   SceneSpec spec;
   spec.seed = seed;
-  spec.frames = options.frames ? options.frames : 96;
+  spec.frames = frames_or_default(options, 96);
   spec.floor = Floor{0.0, {0.0, 0.3, 0.5}};
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);

@@ -45,16 +45,13 @@ const char* kNames[] = {"rectangle", "triangle", "ellipse", "hexagon"};
 }  // namespace
 
 SceneSpec sample_pushing_scene(const MoviOptions& options, std::uint64_t seed) {
-  if (options.frames != 0 && options.frames < 2) {
-    throw ConfigError(fmt::format("frames = {} (needs >= 2)", options.frames));
-  }
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   SceneSpec spec;
   spec.seed = seed;
   spec.physics_step = 1.0 / 250.0;
   spec.steps_per_frame = 3;
-  spec.frames = options.frames ? options.frames : 125 / 3 + 1;
+  spec.frames = frames_or_default(options, 125 / 3 + 1);
   spec.collision_margin = 0.0005;
   spec.floor = Floor{0.0, {0.0, 0.25, 0.0}};
   const double half_thickness = 0.01;

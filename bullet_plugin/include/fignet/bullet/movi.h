@@ -33,6 +33,9 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed);
 // angle within ±30° of the side's normal. Bullet at 250 Hz, 125 steps recorded every 3 (42 frames).
 SceneSpec sample_pushing_scene(const MoviOptions& options, std::uint64_t seed);
 
+// options.frames, or the preset's own count when it is 0; throws ConfigError below 2.
+int frames_or_default(const MoviOptions& options, int preset_frames);
+
 // Dispatches on options.preset; throws ConfigError naming the valid presets.
 SceneSpec sample_scene(const MoviOptions& options, std::uint64_t seed);
 const std::vector<std::string>& movi_presets();
