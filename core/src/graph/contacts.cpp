@@ -72,6 +72,7 @@ void ContactFinder::find_face_pairs(std::span<const ObjectPair> candidates, doub
                                     std::vector<FacePair>& out) const {
   out.clear();
   for (const ObjectPair& pair : candidates) {
+    const size_t first = out.size();
     const Slot& a = slots_[pair.a];
     const Slot& b = slots_[pair.b];
     const PosedMesh posed_a{a.mesh, a.positions, a.kinematic};
@@ -83,6 +84,11 @@ void ContactFinder::find_face_pairs(std::span<const ObjectPair> candidates, doub
         out.push_back({pair.a, fa, pair.b, fb, cp.on_first, cp.on_second, cp.distance});
       }
     });
+    // Traversal order depends on whether the hierarchies were rebuilt or refitted; a fixed
+    // order keeps the network's sums, and so whole rollouts, independent of that history.
+    std::sort(out.begin() + first, out.end(), [](const FacePair& x, const FacePair& y) {
+      return std::tie(x.face_a, x.face_b) < std::tie(y.face_a, y.face_b);
+    });
   }
 }
 
@@ -90,6 +96,7 @@ void ContactFinder::find_node_pairs(std::span<const ObjectPair> candidates, doub
                                     std::vector<NodePair>& out) const {
   out.clear();
   for (const ObjectPair& pair : candidates) {
+    const size_t first = out.size();
     const Slot& a = slots_[pair.a];
     const Slot& b = slots_[pair.b];
     const Eigen::Map<const Points> va(a.positions, a.mesh->num_vertices(), 3);
@@ -97,6 +104,9 @@ void ContactFinder::find_node_pairs(std::span<const ObjectPair> candidates, doub
     a.nodes.for_each_pair_within(b.nodes, radius, [&](std::int32_t i, std::int32_t j) {
       const double distance = (va.row(i) - vb.row(j)).norm();
       if (distance <= radius) out.push_back({pair.a, i, pair.b, j, distance});
+    });
+    std::sort(out.begin() + first, out.end(), [](const NodePair& x, const NodePair& y) {
+      return std::tie(x.node_a, x.node_b) < std::tie(y.node_a, y.node_b);
     });
   }
 }

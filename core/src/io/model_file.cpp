@@ -5,6 +5,7 @@
 
 #include "fignet/error.h"
 #include "hdf5_util.h"
+#include "model_contents.h"
 
 namespace fignet {
 
@@ -89,33 +90,38 @@ ModelConfig read_config(const H5::Group& group) {
 
 }  // namespace
 
+void write_model_contents(H5::H5File& file, const Model& model) {
+  H5::Group root = file.openGroup("/");
+  hdf5::write_attribute(root, "format", std::string(kFormat));
+  hdf5::write_attribute(root, "version", kModelFileVersion);
+  write_config(file.createGroup("config"), model.config());
+  H5::Group parameters = file.createGroup("parameters");
+  for (const TensorInfo& t : model.network().layout().tensors()) {
+    hdf5::write_floats(parameters, t.name, model.parameters().data() + t.offset,
+                       {static_cast<hsize_t>(t.rows), static_cast<hsize_t>(t.cols)});
+  }
+  H5::Group normalizers = file.createGroup("normalizers");
+  for (const auto& [name, normalizer] : named(model.normalizers(), model.network())) {
+    H5::Group group = normalizers.createGroup(name);
+    hdf5::write_attribute(group, "accumulations",
+                          static_cast<long long>(normalizer->accumulations()));
+    hdf5::write_attribute(group, "count", normalizer->count());
+    const hsize_t n = static_cast<hsize_t>(normalizer->size());
+    hdf5::write_doubles(group, "sum", normalizer->sum().data(), {n});
+    hdf5::write_doubles(group, "sum_squares", normalizer->sum_squares().data(), {n});
+  }
+}
+
 void save_model(const Model& model, const std::filesystem::path& path) {
-  hdf5::write_atomically(path, kWhat, [&](H5::H5File& file) {
-    H5::Group root = file.openGroup("/");
-    hdf5::write_attribute(root, "format", std::string(kFormat));
-    hdf5::write_attribute(root, "version", kModelFileVersion);
-    write_config(file.createGroup("config"), model.config());
-    H5::Group parameters = file.createGroup("parameters");
-    for (const TensorInfo& t : model.network().layout().tensors()) {
-      hdf5::write_floats(parameters, t.name, model.parameters().data() + t.offset,
-                         {static_cast<hsize_t>(t.rows), static_cast<hsize_t>(t.cols)});
-    }
-    H5::Group normalizers = file.createGroup("normalizers");
-    for (const auto& [name, normalizer] : named(model.normalizers(), model.network())) {
-      H5::Group group = normalizers.createGroup(name);
-      hdf5::write_attribute(group, "accumulations",
-                            static_cast<long long>(normalizer->accumulations()));
-      hdf5::write_attribute(group, "count", normalizer->count());
-      const hsize_t n = static_cast<hsize_t>(normalizer->size());
-      hdf5::write_doubles(group, "sum", normalizer->sum().data(), {n});
-      hdf5::write_doubles(group, "sum_squares", normalizer->sum_squares().data(), {n});
-    }
-  });
+  hdf5::write_atomically(path, kWhat, [&](H5::H5File& file) { write_model_contents(file, model); });
 }
 
 Model load_model(const std::filesystem::path& path) {
-  H5::H5File file = hdf5::open_for_reading(path, kWhat);
-  const std::string where = fmt::format("{} '{}'", kWhat, path.string());
+  const H5::H5File file = hdf5::open_for_reading(path, kWhat);
+  return read_model_contents(file, fmt::format("{} '{}'", kWhat, path.string()));
+}
+
+Model read_model_contents(const H5::H5File& file, const std::string& where) {
   std::string object = "/";  // what is being read, for error messages
   try {
     const H5::Group root = file.openGroup("/");

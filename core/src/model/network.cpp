@@ -61,6 +61,10 @@ const char* edge_kind_name(EdgeKind kind) {
 }
 
 Network::~Network() = default;
+Network::Network(const Network&) = default;
+Network::Network(Network&&) noexcept = default;
+Network& Network::operator=(const Network&) = default;
+Network& Network::operator=(Network&&) noexcept = default;
 
 Network::Network(const ModelConfig& config)
     : config_((config.validate(), config)),

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
+
+#include "fignet/error.h"
+
 namespace fignet {
 
 Adam::Adam(size_t num_parameters, const AdamConfig& config)
@@ -16,7 +20,11 @@ float Adam::learning_rate() const {
       std::pow(config_.learning_rate_end / config_.learning_rate_start, progress));
 }
 
-void Adam::update(std::vector<float>& params, const std::vector<float>& grads) {
+void Adam::update(std::span<float> params, std::span<const float> grads) {
+  if (params.size() != m_.size() || grads.size() != m_.size()) {
+    throw ConfigError(fmt::format("adam: {} parameters and {} gradients for an optimizer of {}",
+                                  params.size(), grads.size(), m_.size()));
+  }
   const float rate = learning_rate();
   ++step_;
   const float correction1 = 1.0f - std::pow(config_.beta1, static_cast<float>(step_));

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <sstream>
 
 #include "fignet/error.h"
 
@@ -108,6 +109,26 @@ void Trainer::run(std::int64_t steps, const std::function<bool(const TrainStep&)
 double Trainer::evaluate_loss(const std::vector<SampleRef>& samples) {
   prepare_batch(samples, /*accumulate=*/false);
   return loss_and_gradient(false);
+}
+
+TrainerState Trainer::state() const {
+  std::ostringstream rng;
+  rng << rng_;
+  return {adam_.step(), adam_.first_moment(), adam_.second_moment(), rng.str()};
+}
+
+void Trainer::restore(const TrainerState& state) {
+  if (state.first_moment.size() != params_.size() || state.second_moment.size() != params_.size()) {
+    throw ConfigError(fmt::format("trainer: optimizer state has {} and {} entries, the model {}",
+                                  state.first_moment.size(), state.second_moment.size(),
+                                  params_.size()));
+  }
+  std::istringstream rng(state.rng);
+  rng >> rng_;
+  if (!rng) throw ConfigError("trainer: the random generator state cannot be parsed");
+  adam_.first_moment() = state.first_moment;
+  adam_.second_moment() = state.second_moment;
+  adam_.set_step(state.step);
 }
 
 std::shared_ptr<const Model> Trainer::model() const {

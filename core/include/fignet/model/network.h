@@ -48,6 +48,10 @@ class Network {
  public:
   explicit Network(const ModelConfig& config);
   ~Network();
+  Network(const Network&);
+  Network(Network&&) noexcept;
+  Network& operator=(const Network&);
+  Network& operator=(Network&&) noexcept;
 
   const ModelConfig& config() const { return config_; }
   const ParameterLayout& layout() const { return layout_; }

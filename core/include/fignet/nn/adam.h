@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace fignet {
@@ -21,7 +22,8 @@ class Adam {
   Adam(size_t num_parameters, const AdamConfig& config);
 
   // One update of `params` from `grads`; increments step().
-  void update(std::vector<float>& params, const std::vector<float>& grads);
+  // Throws ConfigError when either size differs from the optimizer's.
+  void update(std::span<float> params, std::span<const float> grads);
   float learning_rate() const;  // the rate the next update() will use
   std::int64_t step() const { return step_; }
   const AdamConfig& config() const { return config_; }

@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "fignet/graph/graph_builder.h"
@@ -20,6 +21,14 @@ struct TrainerConfig {
   int batch_size = 4;  // scenes per step, concatenated into one graph
   AdamConfig adam;     // learning rate 1e-3 → 1e-4 over adam.decay_steps
   std::uint64_t seed = 1;
+};
+
+// Everything besides the model that makes training continue exactly where it stopped: the
+// optimizer's moments and step count and the sampling/noise generator's state.
+struct TrainerState {
+  std::int64_t step = 0;
+  std::vector<float> first_moment, second_moment;
+  std::string rng;  // std::mt19937_64 in its standard text form
 };
 
 struct TrainStep {
@@ -46,7 +55,13 @@ class Trainer {
   std::int64_t steps_done() const { return adam_.step(); }
   const std::vector<SampleRef>& samples() const { return samples_; }
 
-  // State for checkpoints and for data-parallel training.
+  // Checkpoints: state() with model() captures training; restore() continues it exactly.
+  TrainerState state() const;
+  // Throws ConfigError when the state does not fit this trainer's parameter count.
+  void restore(const TrainerState& state);
+  const TrainerConfig& trainer_config() const { return trainer_config_; }
+
+  // State for data-parallel training.
   std::vector<float>& parameters() { return params_; }
   Adam& optimizer() { return adam_; }
   Normalizers& normalizers() { return normalizers_; }
@@ -61,7 +76,8 @@ class Trainer {
   TrainerConfig trainer_config_;
   const std::vector<Trajectory>& data_;
   Network network_;
-  std::vector<float> params_, grads_;
+  std::vector<float> params_;
+  AlignedFloats grads_;  // aligned: reductions into it then sum in an address-independent order
   Normalizers normalizers_;
   Adam adam_;
   std::mt19937_64 rng_;

@@ -1,0 +1,82 @@
+#include "fignet/io/checkpoint.h"
+
+#include <fmt/format.h>
+
+#include "fignet/error.h"
+#include "hdf5_util.h"
+#include "model_contents.h"
+
+namespace fignet {
+
+namespace {
+
+constexpr const char* kWhat = "checkpoint";
+
+void write_training(H5::Group group, const TrainerConfig& config, const TrainerState& state) {
+  using hdf5::write_attribute;
+  write_attribute(group, "batch_size", static_cast<long long>(config.batch_size));
+  write_attribute(group, "seed", static_cast<long long>(config.seed));
+  write_attribute(group, "learning_rate_start", double{config.adam.learning_rate_start});
+  write_attribute(group, "learning_rate_end", double{config.adam.learning_rate_end});
+  write_attribute(group, "decay_steps", static_cast<long long>(config.adam.decay_steps));
+  write_attribute(group, "step", static_cast<long long>(state.step));
+  write_attribute(group, "rng", state.rng);
+  const hsize_t n = state.first_moment.size();
+  hdf5::write_floats(group, "adam_first_moment", state.first_moment.data(), {n});
+  hdf5::write_floats(group, "adam_second_moment", state.second_moment.data(), {n});
+}
+
+void read_training(const H5::Group& group, size_t parameters, const std::string& where,
+                   TrainerConfig& config, TrainerState& state) {
+  using namespace hdf5;
+  config.batch_size = static_cast<int>(read_integer(group, "batch_size"));
+  config.seed = static_cast<std::uint64_t>(read_integer(group, "seed"));
+  config.adam.learning_rate_start = static_cast<float>(read_double(group, "learning_rate_start"));
+  config.adam.learning_rate_end = static_cast<float>(read_double(group, "learning_rate_end"));
+  config.adam.decay_steps = read_integer(group, "decay_steps");
+  state.step = read_integer(group, "step");
+  state.rng = read_string(group, "rng");
+  for (auto [name, out] : {std::pair("adam_first_moment", &state.first_moment),
+                           std::pair("adam_second_moment", &state.second_moment)}) {
+    const H5::DataSet dataset = group.openDataSet(name);
+    if (shape_of(dataset) != std::vector<hsize_t>{parameters}) {
+      throw FileError(
+          fmt::format("{}: 'training/{}' does not have {} entries", where, name, parameters));
+    }
+    out->resize(parameters);
+    read_floats(dataset, out->data());
+  }
+}
+
+}  // namespace
+
+void save_checkpoint(const Trainer& trainer, const std::filesystem::path& path) {
+  const auto model = trainer.model();
+  const TrainerState state = trainer.state();
+  hdf5::write_atomically(path, kWhat, [&](H5::H5File& file) {
+    write_model_contents(file, *model);
+    write_training(file.createGroup("training"), trainer.trainer_config(), state);
+  });
+}
+
+Checkpoint load_checkpoint(const std::filesystem::path& path) {
+  const H5::H5File file = hdf5::open_for_reading(path, kWhat);
+  const std::string where = fmt::format("{} '{}'", kWhat, path.string());
+  auto model = std::make_shared<const Model>(read_model_contents(file, where));
+  if (!hdf5::exists(file.openGroup("/"), "training")) {
+    throw FileError(
+        fmt::format("{}: a model file without training state (no /training group); "
+                    "start a new run from it instead of resuming",
+                    where));
+  }
+  TrainerConfig config;
+  TrainerState state;
+  try {
+    read_training(file.openGroup("training"), model->parameters().size(), where, config, state);
+  } catch (const H5::Exception& e) {
+    throw FileError(fmt::format("{}: cannot read 'training' ({})", where, e.getDetailMsg()));
+  }
+  return {std::move(model), config, std::move(state)};
+}
+
+}  // namespace fignet
