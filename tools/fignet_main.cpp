@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   add_info_command(app);
   fignet::cli::add_graph_stats_command(app);
   fignet::cli::add_generate_command(app);
+  fignet::cli::add_train_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

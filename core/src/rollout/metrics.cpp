@@ -119,17 +119,32 @@ Penetration measure_penetration(const Trajectory& trajectory, int frame) {
   return result;
 }
 
-PenetrationRatio penetration_ratio(const Trajectory& predicted, const Trajectory& truth,
-                                   int first) {
-  double depth[2] = {0, 0}, count[2] = {0, 0};
+PenetrationTotals& PenetrationTotals::operator+=(const PenetrationTotals& other) {
+  predicted_depth += other.predicted_depth, truth_depth += other.truth_depth;
+  predicted_count += other.predicted_count, truth_count += other.truth_count;
+  return *this;
+}
+
+PenetrationRatio PenetrationTotals::ratio() const {
+  auto divide = [](double a, double b) { return b > 0 ? a / b : std::nan(""); };
+  return {divide(predicted_depth, truth_depth), divide(predicted_count, truth_count)};
+}
+
+PenetrationTotals penetration_totals(const Trajectory& predicted, const Trajectory& truth,
+                                     int first) {
+  PenetrationTotals totals;
   const int frames = std::min(predicted.num_frames(), truth.num_frames());
   for (int f = first; f < frames; ++f) {
     const Penetration p = measure_penetration(predicted, f), t = measure_penetration(truth, f);
-    depth[0] += p.depth, depth[1] += t.depth;
-    count[0] += p.intersecting_face_pairs, count[1] += t.intersecting_face_pairs;
+    totals +=
+        {p.depth, t.depth, double(p.intersecting_face_pairs), double(t.intersecting_face_pairs)};
   }
-  auto ratio = [](double a, double b) { return b > 0 ? a / b : std::nan(""); };
-  return {ratio(depth[0], depth[1]), ratio(count[0], count[1])};
+  return totals;
+}
+
+PenetrationRatio penetration_ratio(const Trajectory& predicted, const Trajectory& truth,
+                                   int first) {
+  return penetration_totals(predicted, truth, first).ratio();
 }
 
 }  // namespace fignet

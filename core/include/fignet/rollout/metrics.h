@@ -38,6 +38,15 @@ Penetration measure_penetration(const Trajectory& trajectory, int frame);
 struct PenetrationRatio {
   double depth = 0.0, count = 0.0;
 };
+// Penetration sums of a rollout and of its ground truth, which add up over a set of scenes so a
+// set's ratio is not dominated by scenes whose ground truth barely touches.
+struct PenetrationTotals {
+  double predicted_depth = 0, truth_depth = 0, predicted_count = 0, truth_count = 0;
+  PenetrationTotals& operator+=(const PenetrationTotals& other);
+  PenetrationRatio ratio() const;
+};
+PenetrationTotals penetration_totals(const Trajectory& predicted, const Trajectory& truth,
+                                     int first);
 PenetrationRatio penetration_ratio(const Trajectory& predicted, const Trajectory& truth, int first);
 
 }  // namespace fignet

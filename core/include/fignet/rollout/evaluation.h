@@ -1,0 +1,36 @@
+// Rollouts of one predictor over a set of trajectories, summarised the way `fignet eval` and the
+// training validation report them: errors per frame and over the rollout, penetration against the
+// ground truth, face–face edges and time per step.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "fignet/rollout/metrics.h"
+#include "fignet/rollout/predictor.h"
+
+namespace fignet {
+
+struct EvaluationOptions {
+  int frames = -1;           // rollout length (all frames when < 0)
+  bool penetration = false;  // also measure penetration ratios (costly: winding numbers)
+};
+
+struct Evaluation {
+  int trajectories = 0;
+  // Per frame, mean over trajectories (frames 0 … h are given, so 0).
+  std::vector<double> translation, rotation;
+  // Over trajectories: mean of each rollout's mean error and of its last-frame error.
+  double mean_translation = 0, final_translation = 0, mean_rotation = 0, final_rotation = 0;
+  // Penetration of the rollouts as a ratio to the ground truth's (seed H.1); NaN if not measured
+  // or when the ground truth has none.
+  double penetration_depth_ratio = 0, penetration_count_ratio = 0;
+  double face_edges_per_step = 0;    // mean over every predicted step
+  double milliseconds_per_step = 0;  // wall time of predicting one step, graph included
+  std::vector<RolloutErrors> per_trajectory;
+};
+
+Evaluation evaluate_rollouts(AccelerationPredictor& predictor, std::span<const Trajectory> truths,
+                             const EvaluationOptions& options = {});
+
+}  // namespace fignet

@@ -1,0 +1,36 @@
+// What `fignet train` runs: the model, the trainer and the run length in one flat set of named
+// fields, read from JSON and overridable one field at a time ("latent_size=64").
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fignet/model/config.h"
+#include "fignet/train/trainer.h"
+
+namespace fignet {
+
+struct TrainingConfig {
+  ModelConfig model;
+  TrainerConfig trainer;
+  std::int64_t steps = 1'000'000;  // total optimisation steps of the run
+
+  // The model preset ("paper" or "small") with the trainer defaults that suit it.
+  static TrainingConfig preset_named(std::string_view name);
+
+  // Field names in documentation order (also the JSON keys).
+  static const std::vector<std::string>& field_names();
+  // One flat JSON object of every field.
+  std::string to_json() const;
+  // Sets the fields present in a JSON object; `where` names the source in errors. Unknown keys
+  // and wrongly typed values throw ConfigError naming the key.
+  void apply_json(std::string_view json, const std::string& where);
+  // Sets one field from "key=value" (value in JSON syntax; bare words are strings).
+  void apply_setting(std::string_view setting);
+  // Throws ConfigError naming the first invalid field.
+  void validate() const;
+};
+
+}  // namespace fignet

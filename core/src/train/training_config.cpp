@@ -1,0 +1,199 @@
+#include "fignet/train/training_config.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <functional>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "fignet/error.h"
+
+namespace fignet {
+
+namespace {
+
+using json = nlohmann::json;
+
+// One named field: how to read it out and how to set it from JSON.
+struct Field {
+  std::function<json(const TrainingConfig&)> get;
+  std::function<void(TrainingConfig&, const json&)> set;
+};
+
+template <class T, class Member>
+Field plain(Member member) {
+  return {[member](const TrainingConfig& c) {
+            const T value = member(const_cast<TrainingConfig&>(c));
+            // Floats print as their shortest decimal (0.001, not 0.0010000000474974513).
+            if constexpr (std::is_same_v<T, float>) return json::parse(fmt::format("{}", value));
+            return json(value);
+          },
+          [member](TrainingConfig& c, const json& v) { member(c) = v.get<T>(); }};
+}
+
+template <class Enum>
+Field named_enum(Enum& (*member)(TrainingConfig&),
+                 std::vector<std::pair<Enum, std::string>> names) {
+  return {[=](const TrainingConfig& c) {
+            for (const auto& [value, name] : names)
+              if (member(const_cast<TrainingConfig&>(c)) == value) return json(name);
+            return json();
+          },
+          [=](TrainingConfig& c, const json& v) {
+            const std::string text = v.get<std::string>();
+            std::vector<std::string> known;
+            for (const auto& [value, name] : names) {
+              if (name == text) {
+                member(c) = value;
+                return;
+              }
+              known.push_back(name);
+            }
+            throw ConfigError(fmt::format("'{}' is not one of {}", text, fmt::join(known, ", ")));
+          }};
+}
+
+const std::vector<std::pair<std::string, Field>>& fields() {
+  static const std::vector<std::pair<std::string, Field>> table = {
+      {"preset", plain<std::string>([](TrainingConfig & c) -> auto& { return c.model.preset; })},
+      {"latent_size", plain<int>([](TrainingConfig & c) -> auto& { return c.model.latent_size; })},
+      {"message_passing_steps",
+       plain<int>([](TrainingConfig & c) -> auto& { return c.model.message_passing_steps; })},
+      {"collision_radius",
+       plain<double>([](TrainingConfig & c) -> auto& { return c.model.graph.collision_radius; })},
+      {"history", plain<int>([](TrainingConfig & c) -> auto& { return c.model.graph.history; })},
+      {"object_nodes",
+       plain<bool>([](TrainingConfig & c) -> auto& { return c.model.graph.object_nodes; })},
+      {"collisions",
+       named_enum<CollisionEdges>(
+           [](TrainingConfig & c) -> auto& { return c.model.graph.collisions; },
+           {{CollisionEdges::kFaceFace, "face"}, {CollisionEdges::kNodeNode, "node"}})},
+      {"floor",
+       named_enum<FloorModel>([](TrainingConfig & c) -> auto& { return c.model.graph.floor; },
+                              {{FloorModel::kMesh, "mesh"},
+                               {FloorModel::kImplicit, "implicit"},
+                               {FloorModel::kNone, "none"}})},
+      {"noise_std", plain<double>([](TrainingConfig & c) -> auto& { return c.model.noise_std; })},
+      {"normalizer_max_accumulations", plain<std::int64_t>([](TrainingConfig & c) -> auto& {
+         return c.model.normalizer_max_accumulations;
+       })},
+      {"model_seed",
+       plain<std::uint64_t>([](TrainingConfig & c) -> auto& { return c.model.seed; })},
+      {"batch_size", plain<int>([](TrainingConfig & c) -> auto& { return c.trainer.batch_size; })},
+      {"learning_rate_start", plain<float>([](TrainingConfig & c) -> auto& {
+         return c.trainer.adam.learning_rate_start;
+       })},
+      {"learning_rate_end",
+       plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.adam.learning_rate_end; })},
+      {"decay_steps",
+       plain<std::int64_t>([](TrainingConfig & c) -> auto& { return c.trainer.adam.decay_steps; })},
+      {"data_seed",
+       plain<std::uint64_t>([](TrainingConfig & c) -> auto& { return c.trainer.seed; })},
+      {"steps", plain<std::int64_t>([](TrainingConfig & c) -> auto& { return c.steps; })},
+  };
+  return table;
+}
+
+const Field* find_field(std::string_view name) {
+  for (const auto& [key, field] : fields())
+    if (key == name) return &field;
+  return nullptr;
+}
+
+void set_field(TrainingConfig& config, const std::string& key, const json& value,
+               const std::string& where) {
+  const Field* field = find_field(key);
+  if (!field) {
+    throw ConfigError(fmt::format("{}: unknown config field '{}'; known fields: {}", where, key,
+                                  fmt::join(TrainingConfig::field_names(), ", ")));
+  }
+  try {
+    field->set(config, value);
+  } catch (const json::exception&) {
+    throw ConfigError(fmt::format("{}: '{}' = {} has the wrong type", where, key, value.dump()));
+  } catch (const ConfigError& e) {
+    throw ConfigError(fmt::format("{}: '{}': {}", where, key, e.what()));
+  }
+}
+
+}  // namespace
+
+TrainingConfig TrainingConfig::preset_named(std::string_view name) {
+  TrainingConfig config;
+  config.model = ModelConfig::preset_named(name);
+  config.trainer.adam.decay_steps = config.steps;
+  return config;
+}
+
+const std::vector<std::string>& TrainingConfig::field_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const auto& [key, field] : fields()) out.push_back(key);
+    return out;
+  }();
+  return names;
+}
+
+std::string TrainingConfig::to_json() const {
+  json out = json::object();
+  for (const auto& [key, field] : fields()) out[key] = field.get(*this);
+  // Keep the documented field order rather than nlohmann's sorted keys.
+  std::string text = "{\n";
+  for (size_t i = 0; i < fields().size(); ++i) {
+    const auto& key = fields()[i].first;
+    text +=
+        fmt::format("  \"{}\": {}{}\n", key, out[key].dump(), i + 1 < fields().size() ? "," : "");
+  }
+  return text + "}";
+}
+
+void TrainingConfig::apply_json(std::string_view text, const std::string& where) {
+  json parsed;
+  try {
+    parsed = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw ConfigError(fmt::format("{}: not valid JSON ({})", where, e.what()));
+  }
+  if (!parsed.is_object()) throw ConfigError(fmt::format("{}: expected a JSON object", where));
+  // The preset first, so the other fields override its values.
+  if (parsed.contains("preset")) {
+    const std::string preset =
+        parsed["preset"].is_string() ? parsed["preset"].get<std::string>() : "";
+    const TrainingConfig base = preset_named(preset);
+    model = base.model;
+  }
+  for (const auto& [key, value] : parsed.items()) set_field(*this, key, value, where);
+}
+
+void TrainingConfig::apply_setting(std::string_view setting) {
+  const auto equals = setting.find('=');
+  const std::string where = fmt::format("--set '{}'", setting);
+  if (equals == std::string_view::npos || equals == 0) {
+    throw ConfigError(fmt::format("{}: expected key=value", where));
+  }
+  const std::string key(setting.substr(0, equals));
+  const std::string text(setting.substr(equals + 1));
+  json value = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (value.is_discarded()) value = text;  // a bare word such as floor=implicit
+  if (key == "preset") {
+    apply_json(json{{"preset", value}}.dump(), where);  // a preset resets the model's fields
+  } else {
+    set_field(*this, key, value, where);
+  }
+}
+
+void TrainingConfig::validate() const {
+  model.validate();
+  if (trainer.batch_size < 1 || trainer.batch_size > 4096) {
+    throw ConfigError(fmt::format("batch_size = {} (must be in 1..4096)", trainer.batch_size));
+  }
+  const AdamConfig& adam = trainer.adam;
+  if (!(adam.learning_rate_start > 0) || !(adam.learning_rate_end > 0)) {
+    throw ConfigError("learning rates must be > 0");
+  }
+  if (adam.decay_steps < 1) throw ConfigError("decay_steps must be >= 1");
+  if (steps < 0) throw ConfigError(fmt::format("steps = {} (must be >= 0)", steps));
+}
+
+}  // namespace fignet

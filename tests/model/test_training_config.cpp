@@ -1,0 +1,69 @@
+#include <gtest/gtest.h>
+
+#include "fignet/error.h"
+#include "fignet/train/training_config.h"
+
+namespace fignet {
+namespace {
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "no ConfigError";
+}
+
+TEST(TrainingConfig, JsonRoundTripKeepsEveryField) {
+  TrainingConfig config = TrainingConfig::preset_named("small");
+  config.model.latent_size = 48;
+  config.model.graph.collision_radius = 0.07;
+  config.model.graph.floor = FloorModel::kImplicit;
+  config.model.graph.collisions = CollisionEdges::kNodeNode;
+  config.trainer.adam.learning_rate_start = 5e-4f;
+  config.trainer.batch_size = 3;
+  config.steps = 1234;
+  TrainingConfig copy = TrainingConfig::preset_named("paper");
+  copy.apply_json(config.to_json(), "test");
+  EXPECT_EQ(copy.to_json(), config.to_json());
+  EXPECT_EQ(copy.model.latent_size, 48);
+  EXPECT_EQ(copy.model.graph.floor, FloorModel::kImplicit);
+  EXPECT_EQ(copy.trainer.adam.learning_rate_start, 5e-4f);
+  EXPECT_NE(config.to_json().find("\"learning_rate_start\": 0.0005,"), std::string::npos);
+}
+
+TEST(TrainingConfig, SettingsOverrideOneFieldAndAPresetResetsTheModel) {
+  TrainingConfig config = TrainingConfig::preset_named("paper");
+  config.apply_setting("latent_size=32");
+  config.apply_setting("floor=none");
+  config.apply_setting("object_nodes=false");
+  EXPECT_EQ(config.model.latent_size, 32);
+  EXPECT_EQ(config.model.graph.floor, FloorModel::kNone);
+  EXPECT_FALSE(config.model.graph.object_nodes);
+  config.apply_setting("preset=small");
+  EXPECT_EQ(config.model.latent_size, 64);
+  EXPECT_EQ(config.model.message_passing_steps, 5);
+}
+
+TEST(TrainingConfig, BadInputNamesTheField) {
+  TrainingConfig config;
+  EXPECT_NE(
+      error_of([&] { config.apply_setting("latent=3"); }).find("unknown config field 'latent'"),
+      std::string::npos);
+  EXPECT_NE(error_of([&] { config.apply_setting("floor=wood"); }).find("'wood' is not one of"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { config.apply_setting("steps"); }).find("expected key=value"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] {
+              config.apply_json("{\"history\": \"two\"}", "f.json");
+            }).find("f.json: 'history' = \"two\" has the wrong type"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { config.apply_json("[1, 2", "f.json"); }).find("f.json: not valid JSON"),
+            std::string::npos);
+  config.trainer.batch_size = 0;
+  EXPECT_NE(error_of([&] { config.validate(); }).find("batch_size = 0"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace fignet

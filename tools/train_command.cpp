@@ -1,0 +1,221 @@
+// `fignet train`: trains a model on trajectory files with periodic validation rollouts, atomic
+// checkpoints, exact resume, and a clean stop on Ctrl-C / SIGTERM.
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+
+#include "commands.h"
+#include "fignet/error.h"
+#include "fignet/io/checkpoint.h"
+#include "fignet/io/model_file.h"
+#include "fignet/io/trajectory_file.h"
+#include "fignet/rollout/evaluation.h"
+#include "fignet/train/training_config.h"
+#include "progress.h"
+#include "training_log.h"
+
+namespace fignet::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct TrainArgs {
+  std::vector<fs::path> data;
+  fs::path valid, config_file, out, checkpoint, log;
+  std::string preset = "paper";
+  std::vector<std::string> settings;
+  std::int64_t steps = -1;
+  bool resume = false;
+  double checkpoint_minutes = 10.0;
+  std::int64_t log_every = 100, valid_every = 2000;
+  int valid_trajectories = 10, threads = 0;
+};
+
+volatile std::sig_atomic_t stop_requested = 0;
+extern "C" void request_stop(int) {
+  stop_requested = 1;
+}
+
+// The run's config: preset, then the JSON file, then --set overrides, then --steps.
+TrainingConfig resolve_config(const TrainArgs& args) {
+  TrainingConfig config = TrainingConfig::preset_named(args.preset);
+  if (!args.config_file.empty()) {
+    std::ifstream in(args.config_file);
+    if (!in) throw FileError(fmt::format("--config '{}': cannot open", args.config_file.string()));
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    config.apply_json(text, fmt::format("--config '{}'", args.config_file.string()));
+  }
+  for (const std::string& setting : args.settings) config.apply_setting(setting);
+  if (args.steps >= 0) config.steps = args.steps;
+  return config;
+}
+
+// Time step and gravity come from the data, which must agree on them.
+void adopt_physics(const std::vector<Trajectory>& data, ModelConfig& model) {
+  model.time_step = data.front().time_step;
+  model.gravity = data.front().gravity;
+  for (size_t i = 0; i < data.size(); ++i) {
+    if (data[i].time_step != model.time_step || data[i].gravity != model.gravity) {
+      throw ConfigError(fmt::format(
+          "trajectory {} has time step {} s and gravity ({}, {}, {}), trajectory 0 {} s and "
+          "({}, {}, {}): train on one physical setting",
+          i, data[i].time_step, data[i].gravity.x(), data[i].gravity.y(), data[i].gravity.z(),
+          model.time_step, model.gravity.x(), model.gravity.y(), model.gravity.z()));
+    }
+  }
+}
+
+void run_train(const TrainArgs& args) {
+  if (args.threads > 0) omp_set_num_threads(args.threads);
+  const fs::path checkpoint_path =
+      args.checkpoint.empty() ? fs::path(args.out.string() + ".ckpt.h5") : args.checkpoint;
+  const fs::path log_path =
+      args.log.empty() ? fs::path(args.out.string() + ".log.jsonl") : args.log;
+  for (const fs::path& file : {args.out, checkpoint_path, log_path}) {
+    const fs::path parent = file.parent_path();
+    if (!parent.empty() && !fs::is_directory(parent)) {
+      throw FileError(
+          fmt::format("'{}': folder '{}' does not exist", file.string(), parent.string()));
+    }
+  }
+  const std::vector<Trajectory> data = read_trajectories(args.data);
+  std::vector<Trajectory> valid;
+  if (!args.valid.empty()) {
+    valid = read_trajectories(args.valid);
+    valid.resize(std::min<size_t>(valid.size(), args.valid_trajectories));
+  }
+
+  // A new run, or the checkpoint's run continued with its own config.
+  TrainingConfig config = resolve_config(args);
+  std::shared_ptr<const Model> initial;
+  TrainerState state;
+  if (args.resume) {
+    Checkpoint checkpoint = load_checkpoint(checkpoint_path);
+    const std::int64_t steps = config.steps;
+    config.model = checkpoint.model->config();
+    config.trainer = checkpoint.trainer_config;
+    config.steps = args.steps >= 0 ? steps : std::max(steps, checkpoint.state.step);
+    initial = checkpoint.model;
+    state = std::move(checkpoint.state);
+    fmt::print("resuming {} at step {}\n", checkpoint_path.string(), state.step);
+  } else {
+    adopt_physics(data, config.model);
+  }
+  config.validate();
+  fmt::print("config:\n{}\n", config.to_json());
+  fmt::print("data: {} trajectories; validation: {} trajectories\n", data.size(), valid.size());
+
+  Trainer trainer(config.model, config.trainer, data, initial.get());
+  if (args.resume) trainer.restore(state);
+  TrainingLog log(log_path, trainer.steps_done());
+
+  stop_requested = 0;
+  std::signal(SIGINT, request_stop);
+  std::signal(SIGTERM, request_stop);
+  auto save = [&] {
+    save_checkpoint(trainer, checkpoint_path);
+    save_model(*trainer.model(), args.out);
+  };
+  ProgressBar bar("train", config.steps, trainer.steps_done());
+  auto last_checkpoint = std::chrono::steady_clock::now();
+  double loss_sum = 0.0;
+  int loss_count = 0;
+  std::int64_t window_start_step = trainer.steps_done();
+  double window_start_time = bar.seconds();
+  while (trainer.steps_done() < config.steps && !stop_requested) {
+    const TrainStep step = trainer.step();
+    loss_sum += step.loss, ++loss_count;
+    if (step.step % args.log_every == 0 || step.step == config.steps) {
+      const double now = bar.seconds();
+      const double rate = (step.step - window_start_step) / std::max(1e-9, now - window_start_time);
+      log.write_step(step.step, loss_sum / loss_count, step.learning_rate, rate);
+      bar.update(step.step,
+                 fmt::format("loss {:.4f}  {:.1f} steps/s", loss_sum / loss_count, rate));
+      loss_sum = 0.0, loss_count = 0;
+      window_start_step = step.step, window_start_time = now;
+    }
+    if (!valid.empty() && (step.step % args.valid_every == 0 || step.step == config.steps)) {
+      ModelPredictor predictor(trainer.model());
+      const Evaluation e = evaluate_rollouts(predictor, valid);
+      log.write_validation(step.step, e);
+      fmt::print(stderr, "\nstep {}: validation translation {:.4f} m, rotation {:.2f} deg\n",
+                 step.step, e.mean_translation, e.mean_rotation);
+    }
+    const auto now = std::chrono::steady_clock::now();
+    if (std::chrono::duration<double>(now - last_checkpoint).count() >=
+        60.0 * args.checkpoint_minutes) {
+      save();
+      last_checkpoint = now;
+    }
+  }
+  bar.finish(trainer.steps_done());
+  save();
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  if (stop_requested) {
+    fmt::print("stopped at step {}; checkpoint {} (continue with --resume)\n", trainer.steps_done(),
+               checkpoint_path.string());
+  } else {
+    fmt::print("trained {} steps; model {}, checkpoint {}, log {}\n", trainer.steps_done(),
+               args.out.string(), checkpoint_path.string(), log_path.string());
+  }
+}
+
+}  // namespace
+
+void add_train_command(CLI::App& app) {
+  auto args = std::make_shared<TrainArgs>();
+  auto* cmd = app.add_subcommand("train", "Train a FIGNet model on trajectory files");
+  cmd->add_option("--data", args->data, "Training trajectory files (shards are concatenated)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--valid", args->valid, "Held-out trajectory file for validation rollouts")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--preset", args->preset,
+                  "Model preset: paper (L=128, M=10) or small (L=64, M=5)")
+      ->check(CLI::IsMember(ModelConfig::preset_names()))
+      ->capture_default_str();
+  cmd->add_option("--config", args->config_file, "JSON file of config fields (see --set)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option(
+      "--set", args->settings, "Override one config field, key=value (repeatable). Fields: " + [] {
+        std::string names;
+        for (const auto& n : TrainingConfig::field_names())
+          names += (names.empty() ? "" : ", ") + n;
+        return names;
+      }());
+  cmd->add_option("--steps", args->steps, "Total optimisation steps (overrides the config)")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{1'000'000'000}));
+  cmd->add_option("--out", args->out, "Model file written at every checkpoint and at the end")
+      ->required();
+  cmd->add_option("--checkpoint", args->checkpoint, "Checkpoint file (default: OUT.ckpt.h5)");
+  cmd->add_flag("--resume", args->resume,
+                "Continue the run in the checkpoint file exactly where it stopped");
+  cmd->add_option("--checkpoint-minutes", args->checkpoint_minutes, "Minutes between checkpoints")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  cmd->add_option("--log", args->log,
+                  "JSON-lines log of loss and validation (default: OUT.log.jsonl)");
+  cmd->add_option("--log-every", args->log_every, "Steps between log lines")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000}))
+      ->capture_default_str();
+  cmd->add_option("--valid-every", args->valid_every, "Steps between validation rollouts")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1'000'000'000}))
+      ->capture_default_str();
+  cmd->add_option("--valid-trajectories", args->valid_trajectories,
+                  "Validation trajectories rolled out each time")
+      ->check(CLI::Range(1, 100'000))
+      ->capture_default_str();
+  cmd->add_option("--threads", args->threads, "OpenMP threads (0: every core)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  cmd->callback([args] { run_train(*args); });
+}
+
+}  // namespace fignet::cli

@@ -1,0 +1,49 @@
+#include "training_log.h"
+
+#include <fmt/format.h>
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "fignet/error.h"
+
+namespace fignet::cli {
+
+TrainingLog::TrainingLog(const std::filesystem::path& path, std::int64_t resume_step) {
+  std::vector<std::string> kept;
+  if (resume_step > 0) {
+    std::ifstream in(path);
+    for (std::string line; std::getline(in, line);) {
+      const auto record = nlohmann::json::parse(line, nullptr, /*allow_exceptions=*/false);
+      if (record.is_object() && record.value("step", std::int64_t{0}) <= resume_step)
+        kept.push_back(line);
+    }
+  }
+  out_.open(path, std::ios::trunc);
+  if (!out_) throw FileError(fmt::format("--log '{}': cannot write", path.string()));
+  for (const std::string& line : kept) out_ << line << '\n';
+  out_.flush();
+}
+
+void TrainingLog::write_step(std::int64_t step, double loss, float learning_rate,
+                             double steps_per_second) {
+  out_ << nlohmann::json{{"step", step},
+                         {"loss", loss},
+                         {"learning_rate", learning_rate},
+                         {"steps_per_second", steps_per_second}}
+              .dump()
+       << std::endl;
+}
+
+void TrainingLog::write_validation(std::int64_t step, const Evaluation& e) {
+  out_ << nlohmann::json{{"step", step},
+                         {"valid_translation_m", e.mean_translation},
+                         {"valid_rotation_deg", e.mean_rotation},
+                         {"valid_final_translation_m", e.final_translation},
+                         {"valid_final_rotation_deg", e.final_rotation}}
+              .dump()
+       << std::endl;
+}
+
+}  // namespace fignet::cli

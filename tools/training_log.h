@@ -1,0 +1,26 @@
+// The machine-readable training log: one JSON object per line, appended as training goes. A
+// resumed run first drops the lines written after its checkpoint, so the log matches the model.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+
+#include "fignet/rollout/evaluation.h"
+
+namespace fignet::cli {
+
+class TrainingLog {
+ public:
+  // Opens `path` for appending, keeping only the lines of steps <= `resume_step` (a fresh run
+  // passes 0 and starts an empty log).
+  TrainingLog(const std::filesystem::path& path, std::int64_t resume_step);
+
+  void write_step(std::int64_t step, double loss, float learning_rate, double steps_per_second);
+  void write_validation(std::int64_t step, const Evaluation& evaluation);
+
+ private:
+  std::ofstream out_;
+};
+
+}  // namespace fignet::cli
