@@ -7,6 +7,8 @@ find_package(nlohmann_json 3 REQUIRED)
 find_package(HDF5 REQUIRED COMPONENTS C CXX)
 if(FIGNET_BUILD_BULLET_PLUGIN)
   find_package(Bullet REQUIRED)  # CMake's FindBullet: BULLET_INCLUDE_DIRS / BULLET_LIBRARIES
+  # Bullet's HACD convex decomposition (libbullet-extras-dev), for non-convex mesh files.
+  find_library(BULLET_HACD_LIBRARY NAMES HACD REQUIRED)
   find_package(urdfdom REQUIRED)
   find_package(assimp REQUIRED)
 endif()

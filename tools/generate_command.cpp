@@ -87,6 +87,9 @@ void add_generate_command(CLI::App& app) {
   cmd->add_option("--max-objects", args->options.scene.max_objects, "Most objects per scene")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
+  cmd->add_option("--assets", args->options.scene.assets,
+                  "Folder of mesh files (OBJ, STL, PLY, glTF, OFF): extra objects for movi-b, the "
+                  "only objects of movi-c");
   cmd->add_option("--threads", args->options.threads, "Worker threads (0: every core)")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();

@@ -7,6 +7,7 @@
 #include <mutex>
 #include <random>
 
+#include "fignet/bullet/mesh_file.h"
 #include "fignet/error.h"
 #include "fignet/geometry/shapes.h"
 
@@ -19,38 +20,65 @@ struct Material {
 };
 constexpr Material kMetal{0.4, 0.3, 2.7};
 constexpr Material kRubber{0.8, 0.7, 1.1};
+constexpr Material kScanned{0.5, 0.5, 1.0};  // MOVi-C: every object
 
-// One unit-scale body per (shape, material), shared by every scene of the process.
-const BodySpec& unit_body(const std::string& shape, const Material& material) {
+// What an object is made from: a MOVi shape by name, or a mesh file scaled so the largest side
+// of its bounding box is `largest_side` (KuBasic shapes span 2 m, MOVi-C's assets 1 m).
+struct Source {
+  std::string name;
+  bool file = false;
+  double largest_side = 0.0;
+};
+
+// The body of `source` at unit scale and density 1; materials and scales are applied per object.
+BodySpec make_unit_geometry(const Source& source) {
+  if (!source.file) {
+    return make_body(make_movi_shape(source.name), 1.0, 0.0, 0.0, movi_convex_parts(source.name));
+  }
+  const TriangleMesh loaded = load_mesh_file(source.name);
+  const Vec3 extent =
+      loaded.vertices().colwise().maxCoeff() - loaded.vertices().colwise().minCoeff();
+  return load_body(source.name, {1.0, {}, 0.0, 0.0}, source.largest_side / extent.maxCoeff());
+}
+
+// Shared by every scene of the process: a mesh file is loaded and decomposed once.
+const BodySpec& unit_geometry(const Source& source) {
   static std::mutex mutex;
   static std::map<std::pair<std::string, double>, BodySpec> cache;
   const std::lock_guard lock(mutex);
-  auto it = cache.find({shape, material.density});
-  if (it == cache.end()) {
-    it = cache
-             .emplace(std::pair(shape, material.density),
-                      make_body(make_movi_shape(shape), material.density, material.friction,
-                                material.restitution, movi_convex_parts(shape)))
-             .first;
-  }
+  const auto key = std::pair(source.name, source.largest_side);
+  auto it = cache.find(key);
+  if (it == cache.end()) it = cache.emplace(key, make_unit_geometry(source)).first;
   return it->second;
 }
 
-// The unit body scaled by s: lengths × s, mass × s³, inertia × s⁵.
-BodySpec scaled_body(const BodySpec& unit, double s) {
+// The unit geometry made of `material` and scaled by s: lengths × s, mass × s³, inertia × s⁵.
+BodySpec make_object(const Source& source, const Material& material, double s) {
+  const BodySpec& unit = unit_geometry(source);
   BodySpec body = unit;
   body.mesh = std::make_shared<const TriangleMesh>(unit.mesh->name(), unit.mesh->vertices() * s,
                                                    unit.mesh->faces());
   for (Points& part : body.convex_parts) part *= s;
-  body.properties.mass *= s * s * s;
-  body.inertia *= s * s * s * s * s;
+  body.properties = {material.density * unit.properties.mass * s * s * s, material.friction,
+                     material.restitution};
+  body.inertia = material.density * unit.inertia * (s * s * s * s * s);
   return body;
+}
+
+// The mesh files of an asset folder, listed once per process.
+const std::vector<std::filesystem::path>& asset_files(const std::filesystem::path& folder) {
+  static std::mutex mutex;
+  static std::map<std::filesystem::path, std::vector<std::filesystem::path>> cache;
+  const std::lock_guard lock(mutex);
+  auto it = cache.find(folder);
+  if (it == cache.end()) it = cache.emplace(folder, list_mesh_files(folder)).first;
+  return it->second;
 }
 
 }  // namespace
 
 const std::vector<std::string>& movi_presets() {
-  static const std::vector<std::string> presets = {"movi-a", "movi-b", "pushing"};
+  static const std::vector<std::string> presets = {"movi-a", "movi-b", "movi-c", "pushing"};
   return presets;
 }
 
@@ -67,8 +95,8 @@ SceneSpec sample_scene(const MoviOptions& options, std::uint64_t seed) {
 }
 
 SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
-  const bool movi_b = options.preset == "movi-b";
-  if (options.preset != "movi-a" && !movi_b) {
+  const bool movi_a = options.preset == "movi-a", movi_c = options.preset == "movi-c";
+  if (!movi_a && !movi_c && options.preset != "movi-b") {
     throw ConfigError(fmt::format("unknown scene preset '{}'; available: {}", options.preset,
                                   fmt::join(movi_presets(), ", ")));
   }
@@ -76,6 +104,26 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
     throw ConfigError(fmt::format("objects range {}..{} is empty or below 1", options.min_objects,
                                   options.max_objects));
   }
+  if (movi_c && options.assets.empty()) {
+    throw ConfigError("preset movi-c takes its objects from a folder of mesh files: give one");
+  }
+  if (movi_a && !options.assets.empty()) {
+    throw ConfigError(
+        "preset movi-a has only cubes, cylinders and spheres: assets need movi-b or "
+        "movi-c");
+  }
+  // MOVi-A: cube, cylinder, sphere. MOVi-B: all eight MOVi shapes and the asset files.
+  // MOVi-C: the asset files only.
+  std::vector<Source> sources;
+  if (!movi_c) {
+    const std::vector<std::string>& shapes = movi_shape_names();
+    for (size_t i = 0; i < (movi_a ? 3 : shapes.size()); ++i) sources.push_back({shapes[i]});
+  }
+  if (!options.assets.empty()) {
+    for (const auto& file : asset_files(options.assets))
+      sources.push_back({file.string(), true, movi_c ? 1.0 : 2.0});
+  }
+  for (const Source& source : sources) unit_geometry(source);  // every asset checked up front
   SceneSpec spec;
   spec.seed = seed;
   spec.frames = frames_or_default(options, 96);
@@ -83,17 +131,18 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> normal;
-  // MOVi-A: cube, cylinder, sphere at scale 0.7 or 1.4; MOVi-B: all eight shapes, scale
-  // U(0.7, 1.4).
-  const std::vector<std::string>& all_shapes = movi_shape_names();
-  const int shape_count = movi_b ? static_cast<int>(all_shapes.size()) : 3;
+  const int source_count = static_cast<int>(sources.size());
   const int count = options.min_objects +
                     static_cast<int>(unit(rng) * (options.max_objects - options.min_objects + 1));
   std::vector<std::pair<Vec3, double>> spheres;  // placed bodies' bounding spheres
   for (int i = 0; i < std::min(count, options.max_objects); ++i) {
-    const std::string& shape = all_shapes[static_cast<int>(unit(rng) * shape_count) % shape_count];
-    const double scale = movi_b ? 0.7 + 0.7 * unit(rng) : (unit(rng) < 0.5 ? 0.7 : 1.4);
-    BodySpec body = scaled_body(unit_body(shape, unit(rng) < 0.5 ? kMetal : kRubber), scale);
+    const Source& source = sources[static_cast<int>(unit(rng) * source_count) % source_count];
+    // Scale: MOVi-A 0.7 or 1.4, MOVi-B U(0.7, 1.4), MOVi-C U(0.75, 3.0).
+    const double scale = movi_a   ? (unit(rng) < 0.5 ? 0.7 : 1.4)
+                         : movi_c ? 0.75 + 2.25 * unit(rng)
+                                  : 0.7 + 0.7 * unit(rng);
+    const Material& material = movi_c ? kScanned : (unit(rng) < 0.5 ? kMetal : kRubber);
+    BodySpec body = make_object(source, material, scale);
     const double radius = body.mesh->vertices().rowwise().norm().maxCoeff();
     bool placed = false;
     for (int attempt = 0; attempt < 100 && !placed; ++attempt) {

@@ -45,6 +45,9 @@ const char* kNames[] = {"rectangle", "triangle", "ellipse", "hexagon"};
 }  // namespace
 
 SceneSpec sample_pushing_scene(const MoviOptions& options, std::uint64_t seed) {
+  if (!options.assets.empty()) {
+    throw ConfigError("preset pushing pushes procedural prisms: assets need movi-b or movi-c");
+  }
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   SceneSpec spec;

@@ -2,6 +2,13 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "fignet/bullet/convex_decomposition.h"
+#include "fignet/bullet/mesh_file.h"
+#include "fignet/error.h"
 #include "fignet/geometry/mass_properties.h"
 
 namespace fignet::bullet {
@@ -30,6 +37,40 @@ BodySpec make_body(const TriangleMesh& mesh, double density, double friction, do
     }
   }
   return body;
+}
+
+}  // namespace fignet::bullet
+
+namespace fignet::bullet {
+
+BodySpec load_body(const std::filesystem::path& mesh_file, const BodyMaterial& material,
+                   double scale) {
+  if (!(scale > 0.0) || !std::isfinite(scale)) {
+    throw ConfigError(
+        fmt::format("mesh file '{}': scale {} (must be > 0)", mesh_file.string(), scale));
+  }
+  const TriangleMesh loaded = load_mesh_file(mesh_file);
+  const TriangleMesh mesh(loaded.name(), loaded.vertices() * scale, loaded.faces());
+  if (!mesh.is_closed()) {
+    throw MeshError(
+        fmt::format("mesh file '{}': not closed, so it has no volume and no mass; a "
+                    "dynamic body needs a watertight mesh",
+                    mesh_file.string()));
+  }
+  double density = material.density;
+  if (material.mass) {
+    if (!(*material.mass > 0.0)) {
+      throw ConfigError(
+          fmt::format("mesh file '{}': mass {} (must be > 0)", mesh_file.string(), *material.mass));
+    }
+    density = *material.mass / compute_mass_properties(mesh).volume;
+  }
+  if (!(density > 0.0)) {
+    throw ConfigError(
+        fmt::format("mesh file '{}': density {} (must be > 0)", mesh_file.string(), density));
+  }
+  return make_body(mesh, density, material.friction, material.restitution,
+                   decompose_into_convex_parts(mesh));
 }
 
 }  // namespace fignet::bullet

@@ -134,28 +134,6 @@ TEST(Generator, PusherFollowsItsScriptedPathExactly) {
   EXPECT_GE(moved, 5);
 }
 
-TEST(NonConvexBodies, ATorusHangsOnAPeg) {
-  // A horizontal peg (a 10 cm square bar along x, top at z = 2.05) through the hole of a torus
-  // (R = 0.7, r = 0.3) whose axis is along x. Hanging, the ring's inner surface rests on the peg:
-  // centre at 2.05 − (R − r) = 1.65. A convex hull would fill the hole and throw the torus off.
-  SceneSpec spec;
-  spec.frames = 96;
-  spec.floor = Floor{};
-  BodySpec peg = make_body(make_box(Vec3(1.0, 0.05, 0.05), 1), 1.0, 0.5, 0.0);
-  peg.kinematic = true;
-  peg.pose.position = Vec3(0, 0, 2.0);
-  BodySpec torus = make_body(make_movi_shape("torus"), 1.0, 0.5, 0.0, movi_convex_parts("torus"));
-  ASSERT_EQ(torus.convex_parts.size(), 32u);
-  torus.pose.orientation = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY());  // axis z -> x
-  torus.pose.position = Vec3(0, 0, 1.7);
-  spec.bodies = {peg, torus};
-  BulletSimulation simulation(spec);
-  const Trajectory t = simulation.record();
-  const Vec3 end = t.objects[1].poses.back().position;
-  EXPECT_NEAR(end.z(), 1.65, 0.05) << "the torus fell off or rests on top of the peg";
-  EXPECT_NEAR(end.y(), 0.0, 0.05);
-}
-
 TEST(Generator, MoviBUsesEveryShapeAtContinuousScales) {
   std::set<std::string> names;
   for (std::uint64_t seed = 0; seed < 40; ++seed) {

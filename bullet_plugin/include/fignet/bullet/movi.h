@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -11,9 +12,11 @@
 namespace fignet::bullet {
 
 struct MoviOptions {
-  std::string preset = "movi-a";  // "movi-a", "movi-b" or "pushing"
+  std::string preset = "movi-a";  // "movi-a", "movi-b", "movi-c" or "pushing"
   int min_objects = 3, max_objects = 10;
   int frames = 0;  // 0: the preset's own (movi-a 96, pushing 42)
+  // A folder of mesh files: extra objects for movi-b, the only objects of movi-c.
+  std::filesystem::path assets;
 };
 
 // The scene of `seed`: 3–10 objects from {cube, cylinder, sphere}, scale 0.7 or 1.4, metal
@@ -23,7 +26,11 @@ struct MoviOptions {
 // velocity uniform in (−4,−4,0)–(4,4,0) minus the spawn point's (x, y, 0): tossed toward the
 // centre. Floor friction 0.3, restitution 0.5; gravity (0, 0, −10). "movi-b" draws from all eight
 // MOVi shapes (non-convex ones as compounds of their exact convex parts) with scale uniform in
-// 0.7–1.4. Throws ConfigError for a bad option.
+// 0.7–1.4, plus the mesh files of options.assets scaled to a 2 m largest side like the KuBasic
+// shapes. "movi-c" draws only from options.assets: largest side 1 m times U(0.75, 3.0) (Kubric's
+// MOVi-C worker), friction 0.5, restitution 0.5, density 1.0 (facts §1). Mesh files must be
+// closed; non-convex ones collide as HACD decompositions. Throws ConfigError for a bad option,
+// FileError or MeshError for a bad asset folder or file.
 SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed);
 
 // The MIT-pushing stand-in (seed B.2, facts §2) of `seed`: a planar prism (rectangle, triangle,

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -42,5 +43,17 @@ struct SceneSpec {
 // `convex_parts` (in the mesh's frame) describe a non-convex mesh as a union of convex pieces.
 BodySpec make_body(const TriangleMesh& mesh, double density, double friction, double restitution,
                    const std::vector<Points>& convex_parts = {});
+
+struct BodyMaterial {
+  double density = 1000.0;  // kg/m³; ignored when mass is set
+  std::optional<double> mass;
+  double friction = 0.5, restitution = 0.0;
+};
+
+// One call from a mesh file (OBJ, STL, PLY, glTF, OFF through assimp) to a body: the mesh scaled
+// by `scale`, convex or split into convex parts by HACD, mass from the material. The mesh must be
+// closed. Throws FileError or MeshError naming the file.
+BodySpec load_body(const std::filesystem::path& mesh_file, const BodyMaterial& material,
+                   double scale = 1.0);
 
 }  // namespace fignet::bullet
