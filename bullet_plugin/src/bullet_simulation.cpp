@@ -2,33 +2,12 @@
 
 #include <btBulletDynamicsCommon.h>
 
+#include "fignet/bullet/conversions.h"
 #include "fignet/error.h"
 
 namespace fignet::bullet {
 
 namespace {
-
-btVector3 to_bt(const Vec3& v) {
-  return btVector3(btScalar(v.x()), btScalar(v.y()), btScalar(v.z()));
-}
-Vec3 from_bt(const btVector3& v) {
-  return Vec3(v.x(), v.y(), v.z());
-}
-
-btTransform to_bt(const Pose& pose) {
-  const Eigen::Quaterniond q = pose.orientation.normalized();
-  return btTransform(
-      btQuaternion(btScalar(q.x()), btScalar(q.y()), btScalar(q.z()), btScalar(q.w())),
-      to_bt(pose.position));
-}
-
-Pose from_bt(const btTransform& transform) {
-  const btQuaternion q = transform.getRotation();
-  Pose pose;
-  pose.position = from_bt(transform.getOrigin());
-  pose.orientation = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized();
-  return pose;
-}
 
 // Pose of a kinematic body moving with constant linear and angular velocity for `seconds`.
 Pose scripted_pose(const BodySpec& body, double seconds) {

@@ -225,6 +225,23 @@ TriangleMesh make_cone(double radius, double height, int segments) {
   return revolve("cone", {{0.0, -height / 2}, {radius, -height / 2}, {0.0, height / 2}}, segments);
 }
 
+TriangleMesh make_capsule(double radius, double half_height, int cap_rings, int segments) {
+  require(radius > 0 && half_height > 0, "capsule", "needs radius > 0 and half height > 0");
+  require(cap_rings >= 1 && segments >= 3, "capsule", "too few rings or segments");
+  // Poles, then rings down the bottom hemisphere's quarter circle and up the top one.
+  std::vector<Eigen::Vector2d> profile = {{0.0, -half_height - radius}};
+  for (int k = 1; k <= cap_rings; ++k) {
+    const double angle = 0.5 * kPi * k / cap_rings;  // from the pole to the equator
+    profile.emplace_back(radius * std::sin(angle), -half_height - radius * std::cos(angle));
+  }
+  for (int k = cap_rings; k >= 1; --k) {
+    const double angle = 0.5 * kPi * k / cap_rings;
+    profile.emplace_back(radius * std::sin(angle), half_height + radius * std::cos(angle));
+  }
+  profile.emplace_back(0.0, half_height + radius);
+  return revolve("capsule", profile, segments);
+}
+
 TriangleMesh make_torus(double major_radius, double minor_radius, int major_segments,
                         int minor_segments) {
   require(minor_radius > 0 && major_radius > minor_radius, "torus",

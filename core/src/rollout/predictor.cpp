@@ -17,6 +17,17 @@ ModelPredictor::ModelPredictor(std::shared_ptr<const Model> model)
 
 void ModelPredictor::predict(const Scene& scene, Points& accelerations) {
   builder_.build(scene, graph_);
+  run_network(scene, accelerations);
+}
+
+void ModelPredictor::predict_with_candidates(const Scene& scene,
+                                             std::span<const ObjectPair> candidates,
+                                             Points& accelerations) {
+  builder_.build_with_candidates(scene, candidates, graph_);
+  run_network(scene, accelerations);
+}
+
+void ModelPredictor::run_network(const Scene& scene, Points& accelerations) {
   const ConstMatrixView normalized = model_->network().forward(
       model_->parameters().data(), model_->normalizers(), graph_, workspace_, false);
   // The scene's objects come first in the graph; a mesh floor's nodes follow and are dropped.

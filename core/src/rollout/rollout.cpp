@@ -16,6 +16,10 @@ Pose next_kinematic_pose(const SceneObject& object) {
 void predict_next_poses(AccelerationPredictor& predictor, const Scene& scene,
                         std::vector<Pose>& next, StepWorkspace& workspace) {
   predictor.predict(scene, workspace.accelerations);
+  integrate_next_poses(scene, next, workspace);
+}
+
+void integrate_next_poses(const Scene& scene, std::vector<Pose>& next, StepWorkspace& workspace) {
   next.resize(scene.objects.size());
   Eigen::Index row = 0;
   for (size_t o = 0; o < scene.objects.size(); ++o) {

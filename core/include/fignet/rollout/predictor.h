@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <span>
 
 #include "fignet/graph/graph_builder.h"
 #include "fignet/model/model.h"
@@ -18,6 +19,14 @@ class AccelerationPredictor {
   // One row per node of scene.objects, in order: the finite-difference acceleration
   // x^{t+1} − 2x^t + x^{t−1} in metres (rows of kinematic objects are ignored by callers).
   virtual void predict(const Scene& scene, Points& accelerations) = 0;
+  // As predict(), with the object pairs to examine for contacts given by the caller (a physics
+  // engine's broadphase; the floor, when a mesh, is object scene.objects.size()). Predictors
+  // without a contact graph ignore them.
+  virtual void predict_with_candidates(const Scene& scene, std::span<const ObjectPair> candidates,
+                                       Points& accelerations) {
+    (void)candidates;
+    predict(scene, accelerations);
+  }
   // Face–face edges of the last prediction's graph (0 for predictors without a graph).
   virtual int last_face_edges() const { return 0; }
 };
@@ -28,12 +37,17 @@ class ModelPredictor : public AccelerationPredictor {
   explicit ModelPredictor(std::shared_ptr<const Model> model);
   int history() const override { return model_->config().graph.history; }
   void predict(const Scene& scene, Points& accelerations) override;
+  void predict_with_candidates(const Scene& scene, std::span<const ObjectPair> candidates,
+                               Points& accelerations) override;
   int last_face_edges() const override { return graph_.face_edges.size(); }
   // The graph of the last prediction (for edge counts and debug drawing).
   const Graph& last_graph() const { return graph_; }
   const GraphBuilder& builder() const { return builder_; }
 
  private:
+  // Runs the network on graph_ and un-normalises the scene's node rows.
+  void run_network(const Scene& scene, Points& accelerations);
+
   std::shared_ptr<const Model> model_;
   GraphBuilder builder_;
   Graph graph_;

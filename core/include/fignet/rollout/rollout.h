@@ -17,6 +17,9 @@ struct StepWorkspace {
 // The next pose of every object of `scene` (kinematic objects: their given next pose).
 void predict_next_poses(AccelerationPredictor& predictor, const Scene& scene,
                         std::vector<Pose>& next, StepWorkspace& workspace);
+// The integration half of predict_next_poses, for callers that ran the predictor themselves
+// (FIGNetDynamicsWorld): workspace.accelerations holds one row per node of scene.objects.
+void integrate_next_poses(const Scene& scene, std::vector<Pose>& next, StepWorkspace& workspace);
 
 // Replays `truth` from its first h+1 frames: dynamic objects are predicted for frames h+1 …
 // frames−1 (all frames when frames < 0), kinematic ones copied from `truth`. When given,

@@ -1,0 +1,77 @@
+// FIGNetDynamicsWorld: a btDiscreteDynamicsWorld whose dynamic bodies are moved by a learned
+// FIGNet model instead of Bullet's constraint solver. Switching a program is one line:
+//
+//   btDiscreteDynamicsWorld* world = new btDiscreteDynamicsWorld(dispatcher, broadphase, solver, config);
+//   btDiscreteDynamicsWorld* world = new fignet::bullet::FIGNetDynamicsWorld(dispatcher, broadphase, solver, config, model);
+//
+// and stepping with the model's time step: world->stepSimulation(dt, maxSubSteps, 1.0 / 48).
+// Bodies, shapes, motion states, tick callbacks, sleeping, collision filtering and debug drawing
+// work as in Bullet; see docs/bullet-world.md for what differs.
+#pragma once
+
+#include <btBulletDynamicsCommon.h>
+
+#include <memory>
+
+#include "fignet/graph/config.h"
+#include "fignet/model/model.h"
+#include "fignet/rollout/predictor.h"
+
+namespace fignet::bullet {
+
+struct FIGNetWorldOptions {
+  // stepSimulation's fixed time step must equal the model's training step (anything else
+  // changes what the network's velocities mean); true accepts any step, at the user's risk.
+  bool allow_time_step_mismatch = false;
+  // Bodies must fall with the model's training gravity; true accepts another.
+  bool allow_gravity_mismatch = false;
+  // Broadphase boxes grow by d_c plus the distance a body moved in its last step, so a fast body
+  // still finds what it is about to hit (false: d_c only, as in training).
+  bool grow_search_by_travel = true;
+};
+
+// What the last internal step simulated and what it cost.
+struct FIGNetStepStats {
+  int simulated_bodies = 0;   // awake dynamic bodies predicted by the model
+  int sleeping_bodies = 0;    // dynamic bodies skipped because Bullet put them to sleep
+  int kinematic_objects = 0;  // static and kinematic bodies in contact range, floor excluded
+  int candidate_pairs = 0;    // broadphase pairs handed to the face-pair search
+  int face_edges = 0;         // face–face edges of the graph
+  double prepare_seconds = 0;      // broadphase, islands, meshes and histories
+  double predict_seconds = 0;      // graph and network
+  double write_back_seconds = 0;   // rigid fits and Bullet state
+};
+
+class FIGNetDynamicsWorld : public btDiscreteDynamicsWorld {
+ public:
+  // Constructed like btDiscreteDynamicsWorld plus a loaded model (shared, immutable).
+  FIGNetDynamicsWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
+                      btConstraintSolver* solver, btCollisionConfiguration* configuration,
+                      std::shared_ptr<const Model> model, const FIGNetWorldOptions& options = {});
+  // Any predictor (a stand-in for tests and baselines) with the setting it assumes.
+  FIGNetDynamicsWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
+                      btConstraintSolver* solver, btCollisionConfiguration* configuration,
+                      std::unique_ptr<AccelerationPredictor> predictor, const GraphConfig& graph,
+                      double time_step, const Vec3& gravity,
+                      const FIGNetWorldOptions& options = {});
+  ~FIGNetDynamicsWorld() override;
+
+  void removeRigidBody(btRigidBody* body) override;
+  void removeCollisionObject(btCollisionObject* object) override;
+  // Bullet's drawing, plus each face–face edge of the last step as a line between face centres.
+  void debugDrawWorld() override;
+
+  double model_time_step() const;
+  const FIGNetStepStats& last_step_stats() const;
+
+ protected:
+  void internalSingleStepSimulation(btScalar time_step) override;
+  // Bullet's AABB update with every box grown by the collision radius (and travel).
+  void updateAabbs() override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fignet::bullet
