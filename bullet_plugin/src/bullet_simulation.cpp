@@ -52,7 +52,10 @@ struct BulletSimulation::Impl {
   btCollisionDispatcher dispatcher{&configuration};
   btDbvtBroadphase broadphase;
   btSequentialImpulseConstraintSolver solver;
-  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &configuration};
+  std::unique_ptr<btDiscreteDynamicsWorld> world_owner;
+  btDiscreteDynamicsWorld* world_ = nullptr;
+  int steps_per_frame = 1;
+  btDiscreteDynamicsWorld& world() { return *world_; }
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
   std::vector<std::unique_ptr<btDefaultMotionState>> motion_states;
   std::vector<std::unique_ptr<btRigidBody>> bodies;  // spec order; the floor, if any, last
@@ -60,7 +63,7 @@ struct BulletSimulation::Impl {
 
   ~Impl() {
     // The world must let go of its bodies before they are destroyed.
-    for (auto& body : bodies) world.removeRigidBody(body.get());
+    for (auto& body : bodies) world_->removeRigidBody(body.get());
   }
 
   btRigidBody* add(std::unique_ptr<btCollisionShape> shape, double mass, const btVector3& inertia,
@@ -70,15 +73,24 @@ struct BulletSimulation::Impl {
                                                   shape.get(), inertia);
     bodies.push_back(std::make_unique<btRigidBody>(info));
     shapes.push_back(std::move(shape));
-    world.addRigidBody(bodies.back().get());
+    world_->addRigidBody(bodies.back().get());
     return bodies.back().get();
   }
 };
 
-BulletSimulation::BulletSimulation(const SceneSpec& spec, const SolverSettings& settings)
+BulletSimulation::BulletSimulation(const SceneSpec& spec, const SolverSettings& settings,
+                                   const WorldFactory& make_world)
     : impl_(std::make_unique<Impl>()) {
   impl_->spec = spec;
-  btDiscreteDynamicsWorld& world = impl_->world;
+  Impl& impl = *impl_;
+  impl.world_owner =
+      make_world ? make_world(&impl.dispatcher, &impl.broadphase, &impl.solver, &impl.configuration)
+                 : std::make_unique<btDiscreteDynamicsWorld>(&impl.dispatcher, &impl.broadphase,
+                                                             &impl.solver, &impl.configuration);
+  impl.world_ = impl.world_owner.get();
+  impl.steps_per_frame =
+      settings.steps_per_frame > 0 ? settings.steps_per_frame : spec.steps_per_frame;
+  btDiscreteDynamicsWorld& world = impl.world();
   world.setGravity(to_bt(spec.gravity));
   btContactSolverInfo& info = world.getSolverInfo();
   info.m_numIterations = settings.iterations;
@@ -117,21 +129,23 @@ BulletSimulation::BulletSimulation(const SceneSpec& spec, const SolverSettings& 
 BulletSimulation::~BulletSimulation() = default;
 
 btDiscreteDynamicsWorld& BulletSimulation::world() {
-  return impl_->world;
+  return impl_->world();
 }
 
 void BulletSimulation::step_frame() {
   const SceneSpec& spec = impl_->spec;
-  for (int s = 0; s < spec.steps_per_frame; ++s) {
+  const int steps = impl_->steps_per_frame;
+  const double step = spec.frame_step() / steps;
+  for (int s = 0; s < steps; ++s) {
     ++impl_->steps;
     // Kinematic bodies follow their script through their motion state (Bullet derives their
     // velocity from the change of pose).
     for (size_t i = 0; i < spec.bodies.size(); ++i) {
       if (!spec.bodies[i].kinematic) continue;
       impl_->motion_states[i]->setWorldTransform(
-          to_bt(scripted_pose(spec.bodies[i], impl_->steps * spec.physics_step)));
+          to_bt(scripted_pose(spec.bodies[i], impl_->steps * step)));
     }
-    impl_->world.stepSimulation(btScalar(spec.physics_step), 0, btScalar(spec.physics_step));
+    impl_->world().stepSimulation(btScalar(step), 0, btScalar(step));
   }
 }
 

@@ -2,12 +2,17 @@
 // convex-hull bodies and a static plane floor. Ground truth for datasets and for comparisons.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
 #include "fignet/bullet/scene_spec.h"
 
+class btBroadphaseInterface;
+class btCollisionConfiguration;
+class btConstraintSolver;
 class btDiscreteDynamicsWorld;
+class btDispatcher;
 class btRigidBody;
 
 namespace fignet::bullet {
@@ -19,11 +24,20 @@ struct SolverSettings {
   bool warm_starting = false;
   double restitution_velocity_threshold = 0.0;
   double linear_slop = 0.0;
+  // Bullet steps per recorded frame; 0 takes the scene's (240 Hz: 5 per 48 Hz frame). 1 steps
+  // once per frame: coarse native Bullet, or a FIGNet world at the model's rate.
+  int steps_per_frame = 0;
 };
+
+// Makes the world the scene is simulated in (for example a FIGNetDynamicsWorld); none gives a
+// btDiscreteDynamicsWorld.
+using WorldFactory = std::function<std::unique_ptr<btDiscreteDynamicsWorld>(
+    btDispatcher*, btBroadphaseInterface*, btConstraintSolver*, btCollisionConfiguration*)>;
 
 class BulletSimulation {
  public:
-  explicit BulletSimulation(const SceneSpec& spec, const SolverSettings& settings = {});
+  explicit BulletSimulation(const SceneSpec& spec, const SolverSettings& settings = {},
+                            const WorldFactory& make_world = {});
   ~BulletSimulation();
   BulletSimulation(const BulletSimulation&) = delete;
   BulletSimulation& operator=(const BulletSimulation&) = delete;

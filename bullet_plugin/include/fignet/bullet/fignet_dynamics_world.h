@@ -1,8 +1,9 @@
 // FIGNetDynamicsWorld: a btDiscreteDynamicsWorld whose dynamic bodies are moved by a learned
 // FIGNet model instead of Bullet's constraint solver. Switching a program is one line:
 //
-//   btDiscreteDynamicsWorld* world = new btDiscreteDynamicsWorld(dispatcher, broadphase, solver, config);
-//   btDiscreteDynamicsWorld* world = new fignet::bullet::FIGNetDynamicsWorld(dispatcher, broadphase, solver, config, model);
+//   btDiscreteDynamicsWorld* world = new btDiscreteDynamicsWorld(dispatcher, broadphase, solver,
+//   config); btDiscreteDynamicsWorld* world = new fignet::bullet::FIGNetDynamicsWorld(dispatcher,
+//   broadphase, solver, config, model);
 //
 // and stepping with the model's time step: world->stepSimulation(dt, maxSubSteps, 1.0 / 48).
 // Bodies, shapes, motion states, tick callbacks, sleeping, collision filtering and debug drawing
@@ -32,14 +33,14 @@ struct FIGNetWorldOptions {
 
 // What the last internal step simulated and what it cost.
 struct FIGNetStepStats {
-  int simulated_bodies = 0;   // awake dynamic bodies predicted by the model
-  int sleeping_bodies = 0;    // dynamic bodies skipped because Bullet put them to sleep
-  int kinematic_objects = 0;  // static and kinematic bodies in contact range, floor excluded
-  int candidate_pairs = 0;    // broadphase pairs handed to the face-pair search
-  int face_edges = 0;         // face–face edges of the graph
-  double prepare_seconds = 0;      // broadphase, islands, meshes and histories
-  double predict_seconds = 0;      // graph and network
-  double write_back_seconds = 0;   // rigid fits and Bullet state
+  int simulated_bodies = 0;       // awake dynamic bodies predicted by the model
+  int sleeping_bodies = 0;        // dynamic bodies skipped because Bullet put them to sleep
+  int kinematic_objects = 0;      // static and kinematic bodies in contact range, floor excluded
+  int candidate_pairs = 0;        // broadphase pairs handed to the face-pair search
+  int face_edges = 0;             // face–face edges of the graph
+  double prepare_seconds = 0;     // broadphase, islands, meshes and histories
+  double predict_seconds = 0;     // graph and network
+  double write_back_seconds = 0;  // rigid fits and Bullet state
 };
 
 class FIGNetDynamicsWorld : public btDiscreteDynamicsWorld {

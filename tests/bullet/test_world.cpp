@@ -1,0 +1,298 @@
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "fignet/bullet/bullet_simulation.h"
+#include "fignet/bullet/dataset_generator.h"
+#include "fignet/bullet/shape_mesh.h"
+#include "fignet/error.h"
+#include "fignet/geometry/mass_properties.h"
+#include "fignet/graph/graph_builder.h"
+#include "fignet/train/trainer.h"
+#include "world_fixture.h"
+
+namespace fignet::bullet {
+namespace {
+
+using testing::recording_predictor;
+using testing::WorldFixture;
+
+Pose at(const Vec3& position,
+        const Eigen::Quaterniond& orientation = Eigen::Quaterniond::Identity()) {
+  Pose pose;
+  pose.position = position;
+  pose.orientation = orientation;
+  return pose;
+}
+
+TEST(FIGNetWorld, ExactGravityGivesBallisticMotionAndConsistentState) {
+  WorldFixture fixture(recording_predictor());
+  // Without Bullet's one-step latency, motion states show the step's own result.
+  fixture.world.setLatencyMotionStateInterpolation(false);
+  btRigidBody* box = fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.3f, 0.4f)), 2.0,
+                                 at(Vec3(0, 0, 50)));
+  const Vec3 v0(1.0, -2.0, 3.0);
+  box->setLinearVelocity(to_bt(v0));
+  const double dt = WorldFixture::kStep;
+  const Vec3 g(0, 0, -10);
+  for (int n = 1; n <= 48; ++n) {
+    fixture.step();
+    // x_{n+1} = 2x_n − x_{n−1} + g·dt² from a constant-velocity history:
+    // x_n = x_0 + n·dt·v0 + n(n+1)/2·g·dt², v_n = v0 + n·g·dt.
+    const Vec3 expected = Vec3(0, 0, 50) + n * dt * v0 + 0.5 * n * (n + 1) * dt * dt * g;
+    const Vec3 position = from_bt(box->getCenterOfMassPosition());
+    ASSERT_LT((position - expected).norm(), 2e-4 * (1 + n)) << "step " << n;
+    EXPECT_LT((from_bt(box->getLinearVelocity()) - (v0 + n * dt * g)).norm(), 1e-3);
+    btTransform motion;
+    box->getMotionState()->getWorldTransform(motion);
+    EXPECT_LT((motion.getOrigin() - box->getWorldTransform().getOrigin()).length(), 1e-5);
+  }
+  EXPECT_EQ(fixture.world.last_step_stats().simulated_bodies, 1);
+}
+
+TEST(FIGNetWorld, AKinematicBodyFollowsItsMotionStateExactly) {
+  auto predictor = recording_predictor();
+  auto* recorder = predictor.get();
+  WorldFixture fixture(std::move(predictor));
+  btRigidBody* pusher = fixture.add(std::make_unique<btBoxShape>(btVector3(0.1f, 0.1f, 0.1f)), 0.0,
+                                    at(Vec3(0, 0, 1)));
+  pusher->setCollisionFlags(pusher->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+  pusher->setActivationState(DISABLE_DEACTIVATION);
+  btRigidBody* ball = fixture.add(std::make_unique<btSphereShape>(0.1f), 1.0, at(Vec3(0.25, 0, 1)));
+  (void)ball;
+  for (int n = 1; n <= 10; ++n) {
+    const btTransform target(btQuaternion(btVector3(0, 0, 1), 0.1f * n),
+                             btVector3(0.01f * n, 0, 1));
+    pusher->getMotionState()->setWorldTransform(target);
+    fixture.step();
+    EXPECT_EQ(pusher->getWorldTransform().getOrigin(), target.getOrigin());
+    // The graph saw the pusher's next pose as this target.
+    ASSERT_EQ(recorder->last_scene.objects.size(), 2u);
+    const SceneObject& kinematic = recorder->last_scene.objects[1];
+    ASSERT_TRUE(kinematic.kinematic);
+    EXPECT_NEAR(kinematic.next_center.x(), 0.01 * n, 1e-6);
+  }
+}
+
+TEST(FIGNetWorld, BroadphaseFacePairsEqualAllPairsBruteForce) {
+  auto predictor = recording_predictor();
+  auto* recorder = predictor.get();
+  WorldFixture fixture(std::move(predictor));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < 25; ++i) {
+    std::unique_ptr<btCollisionShape> shape;
+    if (i % 3 == 0) shape = std::make_unique<btBoxShape>(btVector3(0.15f, 0.1f, 0.2f));
+    if (i % 3 == 1) shape = std::make_unique<btSphereShape>(0.15f);
+    if (i % 3 == 2) shape = std::make_unique<btCylinderShapeZ>(btVector3(0.1f, 0.1f, 0.2f));
+    const Eigen::Quaterniond q = Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized();
+    fixture.add(std::move(shape), 1.0, at(Vec3(u(rng), u(rng), 0.3 + 0.5 * (u(rng) + 1)), q));
+  }
+  auto floor = std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0.0f);
+  fixture.add(std::move(floor), 0.0, at(Vec3::Zero()));
+  for (int step = 0; step < 3; ++step) {
+    fixture.step();
+    GraphBuilder broadphase_builder({}), brute_force_builder({});
+    Graph graph;
+    broadphase_builder.build_with_candidates(recorder->last_scene, recorder->last_candidates,
+                                             graph);
+    brute_force_builder.build(recorder->last_scene, graph);
+    auto key = [](const FacePair& p) {
+      return std::tuple(p.object_a, p.face_a, p.object_b, p.face_b);
+    };
+    std::set<std::tuple<int, int, int, int>> a, b;
+    for (const FacePair& p : broadphase_builder.face_pairs()) a.insert(key(p));
+    for (const FacePair& p : brute_force_builder.face_pairs()) b.insert(key(p));
+    EXPECT_EQ(a, b);
+    EXPECT_GT(a.size(), 10u);
+  }
+}
+
+TEST(ShapeMeshes, EachShapeTypeHasItsVolumeAndExtent) {
+  struct Case {
+    std::unique_ptr<btCollisionShape> shape;
+    double volume;
+    Vec3 extent;
+    double volume_tolerance = 0.05;  // polygons lose a little of a round shape's volume
+  };
+  const double pi = M_PI;
+  std::vector<Case> cases;
+  cases.push_back({std::make_unique<btBoxShape>(btVector3(0.5f, 1.0f, 1.5f)), 6.0, Vec3(1, 2, 3)});
+  // Spheres keep MOVi's 64 vertices (what the model was trained on): 13 % under the true volume.
+  cases.push_back({std::make_unique<btSphereShape>(1.0f), 4.0 / 3.0 * pi, Vec3(2, 2, 2), 0.15});
+  cases.push_back({std::make_unique<btCylinderShape>(btVector3(0.5f, 1.0f, 0.5f)), pi * 0.25 * 2.0,
+                   Vec3(1, 2, 1)});
+  cases.push_back({std::make_unique<btCylinderShapeX>(btVector3(1.0f, 0.5f, 0.5f)), pi * 0.25 * 2.0,
+                   Vec3(2, 1, 1)});
+  cases.push_back({std::make_unique<btCylinderShapeZ>(btVector3(0.5f, 0.5f, 1.0f)), pi * 0.25 * 2.0,
+                   Vec3(1, 1, 2)});
+  cases.push_back(
+      {std::make_unique<btConeShapeZ>(0.5f, 2.0f), pi * 0.25 * 2.0 / 3.0, Vec3(1, 1, 2)});
+  cases.push_back({std::make_unique<btCapsuleShape>(0.5f, 1.0f),
+                   pi * 0.25 * 1.0 + 4.0 / 3.0 * pi * 0.125, Vec3(1, 2, 1)});
+  auto hull = std::make_unique<btConvexHullShape>();
+  for (int i = 0; i < 8; ++i)
+    hull->addPoint(btVector3(i & 1 ? 1.0f : 0.0f, i & 2 ? 1.0f : 0.0f, i & 4 ? 1.0f : 0.0f));
+  cases.push_back({std::move(hull), 1.0, Vec3(1, 1, 1)});
+  auto scaled = std::make_unique<btBoxShape>(btVector3(0.5f, 0.5f, 0.5f));
+  scaled->setLocalScaling(btVector3(2, 1, 1));
+  cases.push_back({std::move(scaled), 2.0, Vec3(2, 1, 1)});
+  for (auto& c : cases) {
+    SCOPED_TRACE(c.shape->getName());
+    const TriangleMesh mesh = shape_to_mesh(*c.shape);
+    EXPECT_TRUE(mesh.is_closed());
+    EXPECT_NEAR(compute_mass_properties(mesh).volume, c.volume, c.volume_tolerance * c.volume);
+    const Vec3 extent = mesh.vertices().colwise().maxCoeff() - mesh.vertices().colwise().minCoeff();
+    EXPECT_LT((extent - c.extent).cwiseAbs().maxCoeff(), 0.02 * c.extent.maxCoeff());
+  }
+  // A compound of two unit boxes side by side.
+  btBoxShape unit(btVector3(0.5f, 0.5f, 0.5f));
+  btCompoundShape compound;
+  compound.addChildShape(btTransform(btQuaternion::getIdentity(), btVector3(-0.5f, 0, 0)), &unit);
+  compound.addChildShape(btTransform(btQuaternion::getIdentity(), btVector3(0.5f, 0, 0)), &unit);
+  const TriangleMesh mesh = shape_to_mesh(compound);
+  EXPECT_NEAR(compute_mass_properties(mesh).volume, 2.0, 1e-9);
+  EXPECT_NEAR(mesh.vertices().col(0).maxCoeff() - mesh.vertices().col(0).minCoeff(), 2.0, 1e-6);
+}
+
+TEST(ShapeMeshes, UnsupportedShapesNameThemselves) {
+  btEmptyShape empty;
+  try {
+    shape_to_mesh(empty);
+    ADD_FAILURE() << "no ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("'Empty'"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FIGNetWorld, RejectsAnotherTimeStepOrGravity) {
+  WorldFixture fixture(recording_predictor());
+  fixture.add(std::make_unique<btSphereShape>(0.1f), 1.0, at(Vec3(0, 0, 1)));
+  try {
+    fixture.world.stepSimulation(1.0f / 60.0f, 1, 1.0f / 60.0f);
+    ADD_FAILURE() << "no ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("differs from the model's"), std::string::npos);
+  }
+  fixture.world.setGravity(btVector3(0, 0, -9.81f));
+  fixture.bodies.back()->setGravity(btVector3(0, 0, -9.81f));
+  EXPECT_THROW(fixture.step(), ConfigError);
+}
+
+TEST(FIGNetWorld, BodiesComeAndGoMidRunAndVelocityChangesReseedHistory) {
+  auto predictor = recording_predictor();
+  auto* recorder = predictor.get();
+  WorldFixture fixture(std::move(predictor));
+  btRigidBody* first = fixture.add(std::make_unique<btSphereShape>(0.1f), 1.0, at(Vec3(0, 0, 5)));
+  fixture.step(3);
+  btRigidBody* second = fixture.add(std::make_unique<btSphereShape>(0.1f), 1.0, at(Vec3(3, 0, 5)));
+  second->setLinearVelocity(btVector3(2, 0, 0));
+  fixture.step();
+  ASSERT_EQ(recorder->last_scene.objects.size(), 2u);
+  // The newcomer's history was seeded from its velocity: 2 m/s over the last two steps.
+  const SceneObject& seeded = recorder->last_scene.objects[1];
+  EXPECT_NEAR(seeded.centers(2, 0) - seeded.centers(1, 0), 2.0 * WorldFixture::kStep, 1e-6);
+  // An impulse changes the velocity before the next step.
+  first->applyCentralImpulse(btVector3(0, 5, 0));
+  fixture.step();
+  EXPECT_NEAR(first->getLinearVelocity().y(), 5.0, 1e-4);
+  fixture.world.removeRigidBody(second);
+  fixture.step();
+  EXPECT_EQ(recorder->last_scene.objects.size(), 1u);
+  fixture.world.addRigidBody(second);  // so the fixture can remove it again
+}
+
+TEST(FIGNetWorld, RestingBodiesSleepAndWakeWhenTouched) {
+  // A predictor that keeps everything still: bodies rest, fall asleep after Bullet's 2 s.
+  class Still : public testing::RecordingPredictor {
+   public:
+    Still() : RecordingPredictor(Vec3::Zero(), 1.0 / 48.0) {}
+  };
+  auto predictor = std::make_unique<Still>();
+  auto* recorder = predictor.get();
+  GraphConfig graph;
+  WorldFixture fixture(std::move(predictor), graph, {true, true, true});
+  btRigidBody* resting = fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0,
+                                     at(Vec3(0, 0, 0.2)));
+  btRigidBody* far = fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0,
+                                 at(Vec3(5, 0, 0.2)));
+  fixture.step(150);  // > 2 s
+  EXPECT_FALSE(resting->isActive());
+  EXPECT_EQ(fixture.world.last_step_stats().sleeping_bodies, 2);
+  EXPECT_EQ(fixture.world.last_step_stats().simulated_bodies, 0);
+  // Moving one body next to the sleeping one wakes it; the far one sleeps on.
+  far->activate(true);
+  far->setWorldTransform(bullet::to_bt(at(Vec3(0.45, 0, 0.2))));
+  far->getMotionState()->setWorldTransform(far->getWorldTransform());
+  fixture.step();
+  EXPECT_TRUE(resting->isActive());
+  EXPECT_EQ(recorder->last_scene.objects.size(), 2u);
+}
+
+TEST(FIGNetWorld, CollisionFilteringKeepsFilteredPairsOutOfTheGraph) {
+  auto predictor = recording_predictor();
+  auto* recorder = predictor.get();
+  WorldFixture fixture(std::move(predictor));
+  const int group_a = 2, group_b = 4;
+  auto add_box = [&](const Vec3& p, int group, int mask) {
+    auto shape = std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f));
+    btVector3 inertia;
+    shape->calculateLocalInertia(1.0f, inertia);
+    fixture.motion_states.push_back(std::make_unique<btDefaultMotionState>(bullet::to_bt(at(p))));
+    btRigidBody::btRigidBodyConstructionInfo info(1.0f, fixture.motion_states.back().get(),
+                                                  shape.get(), inertia);
+    fixture.bodies.push_back(std::make_unique<btRigidBody>(info));
+    fixture.shapes.push_back(std::move(shape));
+    fixture.world.addRigidBody(fixture.bodies.back().get(), group, mask);
+  };
+  add_box(Vec3(0, 0, 1), group_a, group_a);      // collides with group a only
+  add_box(Vec3(0.45, 0, 1), group_b, group_b);   // touching, but filtered out
+  add_box(Vec3(-0.45, 0, 1), group_a, group_a);  // touching and paired
+  fixture.step();
+  ASSERT_EQ(recorder->last_candidates.size(), 1u);
+  EXPECT_EQ(recorder->last_candidates[0].a, 0);
+  EXPECT_EQ(recorder->last_candidates[0].b, 2);
+}
+
+}  // namespace
+}  // namespace fignet::bullet
+
+namespace fignet::bullet {
+namespace {
+
+TEST(FIGNetWorld, ARealModelStepsAMoviASceneWithoutNaN) {
+  GenerateOptions generate;
+  generate.count = 2;
+  generate.seed = 5;
+  generate.scene.frames = 8;
+  const std::vector<Trajectory> data = generate_dataset(generate);
+  ModelConfig config = ModelConfig::preset_named("small");
+  config.latent_size = 16;
+  config.message_passing_steps = 2;
+  Trainer trainer(config, {}, data);
+  trainer.run(5, nullptr);
+  const std::shared_ptr<const Model> model = trainer.model();
+
+  SceneSpec spec = sample_movi_scene({}, 42);
+  spec.frames = 24;
+  SolverSettings settings;
+  settings.steps_per_frame = 1;  // one model step per 48 Hz frame
+  BulletSimulation simulation(spec, settings,
+                              [&](btDispatcher* d, btBroadphaseInterface* b, btConstraintSolver* s,
+                                  btCollisionConfiguration* c) {
+                                return std::make_unique<FIGNetDynamicsWorld>(d, b, s, c, model);
+                              });
+  const Trajectory rollout = simulation.record();
+  ASSERT_EQ(rollout.num_frames(), 24);
+  for (const TrajectoryObject& object : rollout.objects) {
+    for (const Pose& pose : object.poses) {
+      ASSERT_TRUE(pose.position.allFinite());
+      ASSERT_TRUE(pose.orientation.coeffs().allFinite());
+    }
+  }
+  const auto& world = static_cast<FIGNetDynamicsWorld&>(simulation.world());
+  EXPECT_EQ(world.last_step_stats().simulated_bodies, static_cast<int>(spec.bodies.size()));
+}
+
+}  // namespace
+}  // namespace fignet::bullet
