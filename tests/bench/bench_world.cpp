@@ -1,0 +1,138 @@
+// FIGNetDynamicsWorld against native Bullet on the same scenes, in the same run: the whole step
+// with a model, the world's own cost with a network-free predictor (conversion, broadphase, face
+// pairs, write-back), and a few bodies on a large static triangle mesh.
+//
+//   build/release/tests/bench/bench_world
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "fignet/bullet/bullet_simulation.h"
+#include "fignet/bullet/conversions.h"
+#include "fignet/bullet/fignet_dynamics_world.h"
+#include "fignet/bullet/movi.h"
+
+namespace fignet::bullet {
+namespace {
+
+// `count` MOVi-A objects on a grid above the floor, so every body is in play.
+SceneSpec grid_scene(int count) {
+  SceneSpec spec = sample_movi_scene({}, 7);
+  const BodySpec prototype = spec.bodies.front();
+  spec.bodies.clear();
+  const int side = static_cast<int>(std::ceil(std::sqrt(count)));
+  for (int i = 0; i < count; ++i) {
+    BodySpec body = sample_movi_scene({}, 100 + i).bodies.front();
+    body.pose.position = Vec3(3.5 * (i % side), 3.5 * (i / side), 1.6);
+    body.linear_velocity.setZero();
+    spec.bodies.push_back(body);
+  }
+  return spec;
+}
+
+WorldFactory fignet_world(std::shared_ptr<const Model> model) {
+  return [model](btDispatcher* d, btBroadphaseInterface* b, btConstraintSolver* s,
+                 btCollisionConfiguration* c) {
+    return std::make_unique<FIGNetDynamicsWorld>(d, b, s, c, model);
+  };
+}
+
+WorldFactory gravity_world() {
+  return [](btDispatcher* d, btBroadphaseInterface* b, btConstraintSolver* s,
+            btCollisionConfiguration* c) {
+    return std::make_unique<FIGNetDynamicsWorld>(
+        d, b, s, c, std::make_unique<GravityPredictor>(Vec3(0, 0, -10), 1.0 / 48.0), GraphConfig{},
+        1.0 / 48.0, Vec3(0, 0, -10));
+  };
+}
+
+// One 48 Hz frame per iteration: native Bullet takes 5 steps at 240 Hz, FIGNet one.
+void run_frames(benchmark::State& state, const SceneSpec& spec, const SolverSettings& settings,
+                const WorldFactory& factory) {
+  BulletSimulation simulation(spec, settings, factory);
+  for (auto _ : state) simulation.step_frame();
+  state.counters["bodies"] = static_cast<double>(spec.bodies.size());
+  state.SetLabel("per 48 Hz frame");
+}
+
+void NativeBullet240Hz(benchmark::State& state) {
+  run_frames(state, grid_scene(static_cast<int>(state.range(0))), {}, {});
+}
+
+void FIGNetWorldOutsideTheNetwork(benchmark::State& state) {
+  SolverSettings settings;
+  settings.steps_per_frame = 1;
+  run_frames(state, grid_scene(static_cast<int>(state.range(0))), settings, gravity_world());
+}
+
+void FIGNetWorldSmallModel(benchmark::State& state) {
+  SolverSettings settings;
+  settings.steps_per_frame = 1;
+  auto model = std::make_shared<const Model>(ModelConfig::preset_named("small"));
+  run_frames(state, grid_scene(static_cast<int>(state.range(0))), settings, fignet_world(model));
+}
+
+BENCHMARK(NativeBullet240Hz)->Arg(10)->Arg(100)->Unit(benchmark::kMicrosecond);
+BENCHMARK(FIGNetWorldOutsideTheNetwork)->Arg(10)->Arg(100)->Unit(benchmark::kMicrosecond);
+BENCHMARK(FIGNetWorldSmallModel)->Arg(10)->Arg(100)->Unit(benchmark::kMicrosecond);
+
+// A few bodies on a static triangle mesh of n×n half-metre squares: the world's cost should not
+// grow with n, since only the triangles near the bodies enter the graph.
+void FIGNetWorldOnALargeStaticMesh(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  btDefaultCollisionConfiguration configuration;
+  btCollisionDispatcher dispatcher(&configuration);
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  FIGNetDynamicsWorld world(&dispatcher, &broadphase, &solver, &configuration,
+                            std::make_unique<GravityPredictor>(Vec3(0, 0, -10), 1.0 / 48.0),
+                            GraphConfig{}, 1.0 / 48.0, Vec3(0, 0, -10));
+  btTriangleMesh terrain;
+  const float size = 0.5f, corner = -0.25f * n;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const btVector3 a(corner + i * size, corner + j * size, 0), b = a + btVector3(size, 0, 0),
+                                                            c = a + btVector3(size, size, 0),
+                                                            d = a + btVector3(0, size, 0);
+      terrain.addTriangle(a, b, c);
+      terrain.addTriangle(a, c, d);
+    }
+  }
+  btBvhTriangleMeshShape ground(&terrain, true);
+  btRigidBody floor(0, nullptr, &ground);
+  world.addRigidBody(&floor);
+  std::vector<std::unique_ptr<btRigidBody>> bodies;
+  btBoxShape box(btVector3(0.5f, 0.5f, 0.5f));
+  for (int k = 0; k < 3; ++k) {
+    btVector3 inertia;
+    box.calculateLocalInertia(1, inertia);
+    bodies.push_back(std::make_unique<btRigidBody>(1, nullptr, &box, inertia));
+    bodies.back()->setWorldTransform(
+        btTransform(btQuaternion::getIdentity(), btVector3(3.0f * k, 0, 0.55f)));
+    bodies.back()->setActivationState(DISABLE_DEACTIVATION);
+    world.addRigidBody(bodies.back().get());
+  }
+  for (auto _ : state) {
+    // Hold the boxes just above the mesh so every step sees the same contacts.
+    for (int k = 0; k < 3; ++k) {
+      bodies[k]->setWorldTransform(
+          btTransform(btQuaternion::getIdentity(), btVector3(3.0f * k, 0, 0.55f)));
+      bodies[k]->setLinearVelocity(btVector3(0, 0, 0));
+    }
+    world.stepSimulation(1.0f / 48.0f, 1, 1.0f / 48.0f);
+  }
+  state.counters["mesh_triangles"] = 2.0 * n * n;
+  state.counters["graph_objects"] = world.last_step_stats().kinematic_objects;
+  for (auto& body : bodies) world.removeRigidBody(body.get());
+  world.removeRigidBody(&floor);
+}
+BENCHMARK(FIGNetWorldOnALargeStaticMesh)
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(400)
+    ->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace fignet::bullet
+
+BENCHMARK_MAIN();
