@@ -1,32 +1,17 @@
 #include "fignet/bullet/convex_decomposition.h"
 
 #include <HACD/hacdHACD.h>
-#include <LinearMath/btConvexHullComputer.h>
 #include <fmt/format.h>
 
 #include "fignet/error.h"
 #include "fignet/geometry/mass_properties.h"
+#include "mesh_assembler.h"
 
 namespace fignet::bullet {
 
 double convex_hull_volume(const Points& points) {
-  btConvexHullComputer hull;
-  hull.compute(points.data(), sizeof(double) * 3, static_cast<int>(points.rows()), 0.0, 0.0);
-  // Sum of tetrahedra from the first hull vertex over every (fan-triangulated) hull face.
-  double volume = 0.0;
-  if (hull.vertices.size() < 4) return 0.0;
-  const btVector3 origin = hull.vertices[0];
-  for (int f = 0; f < hull.faces.size(); ++f) {
-    const btConvexHullComputer::Edge* first = &hull.edges[hull.faces[f]];
-    const btVector3 a = hull.vertices[first->getSourceVertex()];
-    const btConvexHullComputer::Edge* edge = first->getNextEdgeOfFace();
-    for (; edge->getTargetVertex() != first->getSourceVertex(); edge = edge->getNextEdgeOfFace()) {
-      const btVector3 b = hull.vertices[edge->getSourceVertex()];
-      const btVector3 c = hull.vertices[edge->getTargetVertex()];
-      volume += (a - origin).dot((b - origin).cross(c - origin)) / 6.0;
-    }
-  }
-  return std::abs(volume);
+  const MeshAssembler hull = convex_hull_triangles(points);
+  return hull.empty() ? 0.0 : compute_mass_properties(hull.finish("convex hull")).volume;
 }
 
 std::vector<Points> decompose_into_convex_parts(const TriangleMesh& mesh,
