@@ -38,7 +38,9 @@ BodySpec make_unit_geometry(const Source& source) {
   const TriangleMesh loaded = load_mesh_file(source.name);
   const Vec3 extent =
       loaded.vertices().colwise().maxCoeff() - loaded.vertices().colwise().minCoeff();
-  return load_body(source.name, {1.0, {}, 0.0, 0.0}, source.largest_side / extent.maxCoeff());
+  const double scale = source.largest_side / extent.maxCoeff();
+  return make_body(TriangleMesh(loaded.name(), loaded.vertices() * scale, loaded.faces()),
+                   BodyMaterial{1.0, {}, 0.0, 0.0});
 }
 
 // Shared by every scene of the process: a mesh file is loaded and decomposed once.

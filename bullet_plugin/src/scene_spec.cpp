@@ -43,6 +43,28 @@ BodySpec make_body(const TriangleMesh& mesh, double density, double friction, do
 
 namespace fignet::bullet {
 
+BodySpec make_body(const TriangleMesh& mesh, const BodyMaterial& material) {
+  if (!mesh.is_closed()) {
+    throw MeshError(
+        fmt::format("mesh '{}': not closed, so it has no volume and no mass; a "
+                    "dynamic body needs a watertight mesh",
+                    mesh.name()));
+  }
+  double density = material.density;
+  if (material.mass) {
+    if (!(*material.mass > 0.0)) {
+      throw ConfigError(
+          fmt::format("mesh '{}': mass {} (must be > 0)", mesh.name(), *material.mass));
+    }
+    density = *material.mass / compute_mass_properties(mesh).volume;
+  }
+  if (!(density > 0.0)) {
+    throw ConfigError(fmt::format("mesh '{}': density {} (must be > 0)", mesh.name(), density));
+  }
+  return make_body(mesh, density, material.friction, material.restitution,
+                   decompose_into_convex_parts(mesh));
+}
+
 BodySpec load_body(const std::filesystem::path& mesh_file, const BodyMaterial& material,
                    double scale) {
   if (!(scale > 0.0) || !std::isfinite(scale)) {
@@ -50,27 +72,8 @@ BodySpec load_body(const std::filesystem::path& mesh_file, const BodyMaterial& m
         fmt::format("mesh file '{}': scale {} (must be > 0)", mesh_file.string(), scale));
   }
   const TriangleMesh loaded = load_mesh_file(mesh_file);
-  const TriangleMesh mesh(loaded.name(), loaded.vertices() * scale, loaded.faces());
-  if (!mesh.is_closed()) {
-    throw MeshError(
-        fmt::format("mesh file '{}': not closed, so it has no volume and no mass; a "
-                    "dynamic body needs a watertight mesh",
-                    mesh_file.string()));
-  }
-  double density = material.density;
-  if (material.mass) {
-    if (!(*material.mass > 0.0)) {
-      throw ConfigError(
-          fmt::format("mesh file '{}': mass {} (must be > 0)", mesh_file.string(), *material.mass));
-    }
-    density = *material.mass / compute_mass_properties(mesh).volume;
-  }
-  if (!(density > 0.0)) {
-    throw ConfigError(
-        fmt::format("mesh file '{}': density {} (must be > 0)", mesh_file.string(), density));
-  }
-  return make_body(mesh, density, material.friction, material.restitution,
-                   decompose_into_convex_parts(mesh));
+  return make_body(TriangleMesh(loaded.name(), loaded.vertices() * scale, loaded.faces()),
+                   material);
 }
 
 }  // namespace fignet::bullet

@@ -50,6 +50,10 @@ struct BodyMaterial {
   double friction = 0.5, restitution = 0.0;
 };
 
+// A body from a closed mesh in any frame: convex, or split into convex parts by HACD; mass from
+// the material. Throws MeshError or ConfigError naming the mesh.
+BodySpec make_body(const TriangleMesh& mesh, const BodyMaterial& material);
+
 // One call from a mesh file (OBJ, STL, PLY, glTF, OFF through assimp) to a body: the mesh scaled
 // by `scale`, convex or split into convex parts by HACD, mass from the material. The mesh must be
 // closed. Throws FileError or MeshError naming the file.
