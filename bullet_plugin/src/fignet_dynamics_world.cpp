@@ -66,6 +66,7 @@ struct FIGNetDynamicsWorld::Impl {
     btVector3 written_linear, written_angular;
     bool valid = false;
     double travel = 0.0;  // how far the body's points moved in the last step (bound)
+    double radius = 0.0;  // of the mesh's bounding sphere about the centre of mass
   };
 
   FIGNetWorldOptions options;
@@ -83,6 +84,7 @@ struct FIGNetDynamicsWorld::Impl {
   std::vector<btRigidBody*> dynamic_bodies;  // all dynamic rigid bodies of the world
   std::vector<btRigidBody*> simulated;       // scene.objects[0 … simulated.size()) in order
   std::unordered_map<const btCollisionObject*, int> scene_index;
+  std::unordered_map<const btCollisionObject*, int> dynamic_index;  // into dynamic_bodies
   std::vector<std::unique_ptr<TriangleMesh>> pieces;  // static-mesh triangles near bodies
   std::vector<std::shared_ptr<const TriangleMesh>> meshes;
   std::vector<ObjectPair> candidates;
@@ -116,7 +118,8 @@ struct FIGNetDynamicsWorld::Impl {
       btCollisionObject* object = world.getCollisionObjectArray()[i];
       if (is_dynamic(object)) dynamic_bodies.push_back(btRigidBody::upcast(object));
     }
-    std::unordered_map<const btCollisionObject*, int> index;
+    std::unordered_map<const btCollisionObject*, int>& index = dynamic_index;
+    index.clear();
     for (size_t i = 0; i < dynamic_bodies.size(); ++i) index[dynamic_bodies[i]] = int(i);
     island.resize(dynamic_bodies.size());
     std::iota(island.begin(), island.end(), 0);
@@ -156,7 +159,10 @@ struct FIGNetDynamicsWorld::Impl {
   // or the user moved it or changed its velocity since the last step.
   BodyState& state_of(btRigidBody& body) {
     BodyState& state = states[&body];
-    if (!state.mesh) state.mesh = shapes.mesh_of(*body.getCollisionShape());
+    if (!state.mesh) {
+      state.mesh = shapes.mesh_of(*body.getCollisionShape());
+      state.radius = state.mesh->vertices().rowwise().norm().maxCoeff();
+    }
     const bool unchanged = state.valid && body.getWorldTransform() == state.written &&
                            body.getLinearVelocity() == state.written_linear &&
                            body.getAngularVelocity() == state.written_angular;
@@ -291,9 +297,8 @@ struct FIGNetDynamicsWorld::Impl {
       state.written = body.getWorldTransform();
       state.written_linear = body.getLinearVelocity();
       state.written_angular = body.getAngularVelocity();
-      const double radius = state.mesh->vertices().rowwise().norm().maxCoeff();
       state.travel =
-          (next_pose.position - current.position).norm() + std::abs(turn.angle()) * radius;
+          (next_pose.position - current.position).norm() + std::abs(turn.angle()) * state.radius;
       body.updateDeactivation(btScalar(time_step));
     }
   }

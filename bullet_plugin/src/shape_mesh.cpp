@@ -106,7 +106,7 @@ std::unique_ptr<TriangleMesh> concave_triangles_in_box(const btConcaveShape& sha
 
 std::shared_ptr<const TriangleMesh> ShapeMeshCache::mesh_of(const btCollisionShape& shape) {
   const btVector3& s = shape.getLocalScaling();
-  auto key = std::pair(&shape, std::vector<float>{float(s.x()), float(s.y()), float(s.z())});
+  const auto key = std::pair(&shape, std::array<double, 3>{s.x(), s.y(), s.z()});
   auto it = meshes_.find(key);
   if (it == meshes_.end()) {
     it = meshes_.emplace(key, std::make_shared<const TriangleMesh>(shape_to_mesh(shape))).first;

@@ -4,6 +4,7 @@
 // their size.
 #pragma once
 
+#include <array>
 #include <map>
 #include <memory>
 #include <utility>
@@ -39,7 +40,7 @@ class ShapeMeshCache {
 
  private:
   // Keyed by shape and local scaling: the same shape rescaled is another mesh.
-  std::map<std::pair<const btCollisionShape*, std::vector<float>>,
+  std::map<std::pair<const btCollisionShape*, std::array<double, 3>>,
            std::shared_ptr<const TriangleMesh>>
       meshes_;
 };
