@@ -100,7 +100,10 @@ void run_train(const TrainArgs& args) {
     const std::int64_t steps = config.steps;
     config.model = checkpoint.model->config();
     config.trainer = checkpoint.trainer_config;
-    config.steps = args.steps >= 0 ? steps : std::max(steps, checkpoint.state.step);
+    // The run's own length unless --steps says otherwise.
+    config.steps = args.steps >= 0                ? steps
+                   : checkpoint.planned_steps > 0 ? checkpoint.planned_steps
+                                                  : std::max(steps, checkpoint.state.step);
     initial = checkpoint.model;
     state = std::move(checkpoint.state);
     fmt::print("resuming {} at step {}\n", checkpoint_path.string(), state.step);
@@ -119,7 +122,7 @@ void run_train(const TrainArgs& args) {
   std::signal(SIGINT, request_stop);
   std::signal(SIGTERM, request_stop);
   auto save = [&] {
-    save_checkpoint(trainer, checkpoint_path);
+    save_checkpoint(trainer, checkpoint_path, config.steps);
     save_model(*trainer.model(), args.out);
   };
   ProgressBar bar("train", config.steps, trainer.steps_done());

@@ -55,9 +55,10 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
 
   Trainer first(tiny_model(), trainer_config, data);
   first.run(4, nullptr);
-  save_checkpoint(first, dir_ / "run.ckpt.h5");
+  save_checkpoint(first, dir_ / "run.ckpt.h5", 10);
   const Checkpoint checkpoint = load_checkpoint(dir_ / "run.ckpt.h5");
   EXPECT_EQ(checkpoint.state.step, 4);
+  EXPECT_EQ(checkpoint.planned_steps, 10);
   EXPECT_EQ(checkpoint.trainer_config.batch_size, 2);
   EXPECT_EQ(checkpoint.trainer_config.adam.decay_steps, 20);
   Trainer resumed(checkpoint.model->config(), checkpoint.trainer_config, data,

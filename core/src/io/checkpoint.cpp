@@ -50,12 +50,15 @@ void read_training(const H5::Group& group, size_t parameters, const std::string&
 
 }  // namespace
 
-void save_checkpoint(const Trainer& trainer, const std::filesystem::path& path) {
+void save_checkpoint(const Trainer& trainer, const std::filesystem::path& path,
+                     std::int64_t planned_steps) {
   const auto model = trainer.model();
   const TrainerState state = trainer.state();
   hdf5::write_atomically(path, kWhat, [&](H5::H5File& file) {
     write_model_contents(file, *model);
-    write_training(file.createGroup("training"), trainer.trainer_config(), state);
+    H5::Group training = file.createGroup("training");
+    write_training(training, trainer.trainer_config(), state);
+    hdf5::write_attribute(training, "planned_steps", static_cast<long long>(planned_steps));
   });
 }
 
@@ -71,12 +74,17 @@ Checkpoint load_checkpoint(const std::filesystem::path& path) {
   }
   TrainerConfig config;
   TrainerState state;
+  std::int64_t planned_steps = 0;
   try {
-    read_training(file.openGroup("training"), model->parameters().size(), where, config, state);
+    const H5::Group training = file.openGroup("training");
+    read_training(training, model->parameters().size(), where, config, state);
+    // Absent from checkpoints written before it was recorded.
+    if (training.attrExists("planned_steps"))
+      planned_steps = hdf5::read_integer(training, "planned_steps");
   } catch (const H5::Exception& e) {
     throw FileError(fmt::format("{}: cannot read 'training' ({})", where, e.getDetailMsg()));
   }
-  return {std::move(model), config, std::move(state)};
+  return {std::move(model), config, std::move(state), planned_steps};
 }
 
 }  // namespace fignet
