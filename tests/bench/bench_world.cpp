@@ -92,8 +92,8 @@ void FIGNetWorldOnALargeStaticMesh(benchmark::State& state) {
   for (int i = 0; i < n; ++i) {
     for (int j = 0; j < n; ++j) {
       const btVector3 a(corner + i * size, corner + j * size, 0), b = a + btVector3(size, 0, 0),
-                                                            c = a + btVector3(size, size, 0),
-                                                            d = a + btVector3(0, size, 0);
+                                                                  c = a + btVector3(size, size, 0),
+                                                                  d = a + btVector3(0, size, 0);
       terrain.addTriangle(a, b, c);
       terrain.addTriangle(a, c, d);
     }

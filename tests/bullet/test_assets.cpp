@@ -3,12 +3,12 @@
 #include <fstream>
 #include <set>
 
+#include "../temp_folder.h"
 #include "fignet/bullet/bullet_simulation.h"
 #include "fignet/bullet/dataset_generator.h"
 #include "fignet/error.h"
 #include "fignet/geometry/mass_properties.h"
 #include "fignet/geometry/shapes.h"
-#include "temp_folder.h"
 
 namespace fignet::bullet {
 namespace {

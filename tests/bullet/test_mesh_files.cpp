@@ -3,12 +3,12 @@
 #include <filesystem>
 #include <fstream>
 
+#include "../temp_folder.h"
 #include "fignet/bullet/convex_decomposition.h"
 #include "fignet/bullet/mesh_file.h"
 #include "fignet/error.h"
 #include "fignet/geometry/mass_properties.h"
 #include "fignet/geometry/shapes.h"
-#include "temp_folder.h"
 
 namespace fignet::bullet {
 namespace {

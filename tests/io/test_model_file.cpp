@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "../temp_folder.h"
 #include "fignet/error.h"
 #include "fignet/io/model_file.h"
 
@@ -12,11 +13,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class ModelFile : public ::testing::Test {
+class ModelFile : public testing::TempFolderTest {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("fignet_model_file_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
+    TempFolderTest::SetUp();
     ModelConfig config = ModelConfig::preset_named("small");
     config.latent_size = 16;
     config.message_passing_steps = 2;
@@ -29,7 +29,6 @@ class ModelFile : public ::testing::Test {
     path_ = dir_ / "model.h5";
     save_model(*model_, path_);
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   std::string load_error(const fs::path& path) {
     try {
@@ -41,7 +40,7 @@ class ModelFile : public ::testing::Test {
     return {};
   }
 
-  fs::path dir_, path_;
+  fs::path path_;
   std::unique_ptr<Model> model_;
 };
 

@@ -1,10 +1,10 @@
 #include <H5Cpp.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 
 #include "../model/trajectory_fixtures.h"
+#include "../temp_folder.h"
 #include "fignet/error.h"
 #include "fignet/io/trajectory_file.h"
 
@@ -37,13 +37,8 @@ std::vector<Trajectory> make_data(int count) {
   return data;
 }
 
-class TrajectoryFile : public ::testing::Test {
+class TrajectoryFile : public testing::TempFolderTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("fignet_trajectory_file_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   std::string read_error(const fs::path& path) {
     try {
       read_trajectories(path);
@@ -53,7 +48,6 @@ class TrajectoryFile : public ::testing::Test {
     ADD_FAILURE() << "no FileError";
     return {};
   }
-  fs::path dir_;
 };
 
 TEST_F(TrajectoryFile, WriteThenReadRoundTripsExactly) {

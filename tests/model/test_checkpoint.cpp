@@ -1,8 +1,8 @@
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 
+#include "../temp_folder.h"
 #include "fignet/error.h"
 #include "fignet/io/checkpoint.h"
 #include "fignet/io/model_file.h"
@@ -34,15 +34,7 @@ ModelConfig tiny_model() {
   return config;
 }
 
-class Checkpoints : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("fignet_checkpoint_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
-};
+using Checkpoints = testing::TempFolderTest;
 
 TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   const auto data = falling_cubes();

@@ -1,4 +1,5 @@
-// A temporary folder per test, removed afterwards, and a Wavefront OBJ writer for mesh fixtures.
+// A temporary folder per test (named after the test and the process), removed afterwards, and a
+// Wavefront OBJ writer for mesh fixtures.
 #pragma once
 
 #include <gtest/gtest.h>
