@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config clang-format
   libbullet-dev libbullet-extras-dev
   libeigen3-dev
-  liburdfdom-dev
+  liburdfdom-dev libtinyxml-dev libconsole-bridge-dev
   libassimp-dev assimp-testmodels
   libhdf5-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev

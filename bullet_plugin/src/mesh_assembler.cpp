@@ -19,9 +19,17 @@ void MeshAssembler::triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
 }
 
 void MeshAssembler::append(const TriangleMesh& mesh, const btTransform& transform) {
+  append(mesh, [&](const Vec3& p) { return from_bt(transform * to_bt(p)); });
+}
+
+void MeshAssembler::append(const TriangleMesh& mesh, const Eigen::Isometry3d& transform) {
+  append(mesh, [&](const Vec3& p) { return Vec3(transform * p); });
+}
+
+void MeshAssembler::append(const TriangleMesh& mesh, const std::function<Vec3(const Vec3&)>& move) {
   const int base = static_cast<int>(points_.size());
   for (int v = 0; v < mesh.num_vertices(); ++v)
-    points_.push_back(from_bt(transform * to_bt(Vec3(mesh.vertices().row(v).transpose()))));
+    points_.push_back(move(mesh.vertices().row(v).transpose()));
   for (int f = 0; f < mesh.num_faces(); ++f)
     faces_.push_back(
         {base + mesh.faces()(f, 0), base + mesh.faces()(f, 1), base + mesh.faces()(f, 2)});

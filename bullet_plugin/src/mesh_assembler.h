@@ -6,6 +6,7 @@
 #include <LinearMath/btTransform.h>
 
 #include <array>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -21,12 +22,15 @@ class MeshAssembler {
   // Appends `mesh` moved by `transform`, its vertices kept apart from the others (compound
   // children may touch without sharing a surface).
   void append(const TriangleMesh& mesh, const btTransform& transform);
+  // The same in double precision (a btTransform is float in Debian's Bullet).
+  void append(const TriangleMesh& mesh, const Eigen::Isometry3d& transform);
   bool empty() const { return faces_.empty(); }
   // The mesh, zero-area faces dropped. Throws MeshError as TriangleMesh does.
   TriangleMesh finish(std::string name) const;
 
  private:
   int vertex(const Vec3& p);
+  void append(const TriangleMesh& mesh, const std::function<Vec3(const Vec3&)>& move);
 
   std::map<std::array<double, 3>, int> index_;
   std::vector<Vec3> points_;

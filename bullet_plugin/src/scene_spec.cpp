@@ -13,30 +13,39 @@
 
 namespace fignet::bullet {
 
-BodySpec make_body(const TriangleMesh& mesh, double density, double friction, double restitution,
-                   const std::vector<Points>& convex_parts) {
-  const MassProperties props = compute_mass_properties(mesh);
+BodySpec make_body(const TriangleMesh& mesh, const BodyInertia& inertia, double friction,
+                   double restitution, const std::vector<Points>& convex_parts) {
   // Principal axes: the eigenvectors of the inertia tensor, as a proper rotation.
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(props.inertia);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(inertia.inertia);
   Eigen::Matrix3d axes = solver.eigenvectors();
   if (axes.determinant() < 0) axes.col(2) *= -1.0;
   // Symmetric shapes already sit on their principal axes; keep their frame rather than an
   // arbitrary eigenbasis of repeated moments.
-  const bool diagonal = (props.inertia - Eigen::Matrix3d(props.inertia.diagonal().asDiagonal()))
+  const bool diagonal = (inertia.inertia - Eigen::Matrix3d(inertia.inertia.diagonal().asDiagonal()))
                             .cwiseAbs()
-                            .maxCoeff() <= 1e-9 * props.inertia.trace();
+                            .maxCoeff() <= 1e-9 * inertia.inertia.trace();
   if (diagonal) axes.setIdentity();
-  Points vertices = (mesh.vertices().rowwise() - props.center_of_mass.transpose()) * axes;
+  const Vec3& com = inertia.center_of_mass;
+  Points vertices = (mesh.vertices().rowwise() - com.transpose()) * axes;
   BodySpec body;
   body.mesh = std::make_shared<const TriangleMesh>(mesh.name(), std::move(vertices), mesh.faces());
-  body.properties = {density * props.volume, friction, restitution};
-  body.inertia = density * (axes.transpose() * props.inertia * axes).diagonal();
+  body.properties = {inertia.mass, friction, restitution};
+  body.inertia = (axes.transpose() * inertia.inertia * axes).diagonal();
+  body.pose.position = com;
+  body.pose.orientation = Eigen::Quaterniond(axes);
   if (convex_parts.size() > 1) {
     for (const Points& part : convex_parts) {
-      body.convex_parts.push_back((part.rowwise() - props.center_of_mass.transpose()) * axes);
+      body.convex_parts.push_back((part.rowwise() - com.transpose()) * axes);
     }
   }
   return body;
+}
+
+BodySpec make_body(const TriangleMesh& mesh, double density, double friction, double restitution,
+                   const std::vector<Points>& convex_parts) {
+  const MassProperties props = compute_mass_properties(mesh);
+  return make_body(mesh, {density * props.volume, props.center_of_mass, density * props.inertia},
+                   friction, restitution, convex_parts);
 }
 
 }  // namespace fignet::bullet

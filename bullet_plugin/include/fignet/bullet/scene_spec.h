@@ -38,9 +38,20 @@ struct SceneSpec {
   double frame_step() const { return physics_step * steps_per_frame; }
 };
 
-// A body of `density` made from `mesh` in any frame: the mesh is moved to its principal
-// centre-of-mass frame (Bullet needs a diagonal inertia) and `pose` is the pose of that frame.
-// `convex_parts` (in the mesh's frame) describe a non-convex mesh as a union of convex pieces.
+// Mass, centre of mass and inertia tensor about the centre of mass, in a mesh's frame.
+struct BodyInertia {
+  double mass = 0.0;
+  Vec3 center_of_mass = Vec3::Zero();
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+};
+
+// A body made from `mesh` in any frame: the mesh is moved to its principal centre-of-mass frame
+// (Bullet needs a diagonal inertia) and `pose` is set to where that frame lies in the mesh's
+// frame, so the body sits where the mesh was until the caller moves it. `convex_parts` (in the
+// mesh's frame) describe a non-convex mesh as a union of convex pieces.
+BodySpec make_body(const TriangleMesh& mesh, const BodyInertia& inertia, double friction,
+                   double restitution, const std::vector<Points>& convex_parts = {});
+// The same with the mass properties of the closed mesh at `density`.
 BodySpec make_body(const TriangleMesh& mesh, double density, double friction, double restitution,
                    const std::vector<Points>& convex_parts = {});
 

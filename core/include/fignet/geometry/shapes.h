@@ -25,8 +25,7 @@ TriangleMesh make_cylinder(double radius, double half_height, int segments = 31)
 TriangleMesh make_cone(double radius, double height, int segments = 31);
 // Capsule along z: a cylinder of the given half height between two hemispheres of `cap_rings`
 // rings each (Bullet's btCapsuleShapeZ).
-TriangleMesh make_capsule(double radius, double half_height, int cap_rings = 4,
-                          int segments = 16);
+TriangleMesh make_capsule(double radius, double half_height, int cap_rings = 4, int segments = 16);
 // Torus around z.
 TriangleMesh make_torus(double major_radius, double minor_radius, int major_segments = 32,
                         int minor_segments = 12);
