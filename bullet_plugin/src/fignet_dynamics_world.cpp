@@ -369,6 +369,32 @@ FIGNetDynamicsWorld::~FIGNetDynamicsWorld() = default;
 double FIGNetDynamicsWorld::model_time_step() const {
   return impl_->time_step;
 }
+void FIGNetDynamicsWorld::set_shape_mesh(const btCollisionShape& shape,
+                                         std::shared_ptr<const TriangleMesh> mesh) {
+  if (!mesh) throw ConfigError("FIGNetDynamicsWorld::set_shape_mesh: no mesh");
+  // The mesh must lie in the shape's box, give or take the margin and a 5 % tolerance.
+  btVector3 low, high;
+  shape.getAabb(btTransform::getIdentity(), low, high);
+  const Vec3 lo = from_bt(low), hi = from_bt(high);
+  const double slack = 0.05 * (hi - lo).norm() + shape.getMargin();
+  const Points& v = mesh->vertices();
+  const Vec3 mesh_lo = v.colwise().minCoeff().transpose(),
+             mesh_hi = v.colwise().maxCoeff().transpose();
+  if ((mesh_lo - lo).minCoeff() < -slack || (hi - mesh_hi).minCoeff() < -slack) {
+    throw ConfigError(fmt::format(
+        "FIGNetDynamicsWorld::set_shape_mesh: mesh '{}' spans ({:.3g}, {:.3g}, {:.3g}) to ({:.3g}, "
+        "{:.3g}, {:.3g}), outside its {} shape's box ({:.3g}, {:.3g}, {:.3g}) to ({:.3g}, {:.3g}, "
+        "{:.3g}); is it in the shape's frame and scale?",
+        mesh->name(), mesh_lo.x(), mesh_lo.y(), mesh_lo.z(), mesh_hi.x(), mesh_hi.y(), mesh_hi.z(),
+        shape.getName(), lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z()));
+  }
+  impl_->shapes.set_mesh(shape, std::move(mesh));
+  // Bodies already seen with this shape pick the mesh up at their next step.
+  for (auto& [body, state] : impl_->states) {
+    if (body->getCollisionShape() == &shape) state = {};
+  }
+}
+
 const FIGNetStepStats& FIGNetDynamicsWorld::last_step_stats() const {
   return impl_->stats;
 }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "fignet/bullet/conversions.h"
+#include "fignet/bullet/fignet_dynamics_world.h"
 #include "fignet/error.h"
 
 namespace fignet::bullet {
@@ -61,6 +62,10 @@ btRigidBody* RigidBodies::add(const BodySpec& spec, double collision_margin) {
   btRigidBody* body =
       add(make_shape(spec, collision_margin), mass,
           spec.kinematic ? btVector3(0, 0, 0) : to_bt(spec.inertia), to_bt(spec.pose));
+  // A FIGNet world sees the spec's mesh, not the hull's triangulation of it.
+  if (auto* fignet_world = dynamic_cast<FIGNetDynamicsWorld*>(&world_)) {
+    fignet_world->set_shape_mesh(*body->getCollisionShape(), spec.mesh);
+  }
   body->setFriction(btScalar(spec.properties.friction));
   body->setRestitution(btScalar(spec.properties.restitution));
   if (spec.kinematic) {

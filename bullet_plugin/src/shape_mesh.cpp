@@ -104,9 +104,22 @@ std::unique_ptr<TriangleMesh> concave_triangles_in_box(const btConcaveShape& sha
   return std::make_unique<TriangleMesh>(collector.assembler.finish(shape.getName()));
 }
 
-std::shared_ptr<const TriangleMesh> ShapeMeshCache::mesh_of(const btCollisionShape& shape) {
+namespace {
+
+auto cache_key(const btCollisionShape& shape) {
   const btVector3& s = shape.getLocalScaling();
-  const auto key = std::pair(&shape, std::array<double, 3>{s.x(), s.y(), s.z()});
+  return std::pair(&shape, std::array<double, 3>{s.x(), s.y(), s.z()});
+}
+
+}  // namespace
+
+void ShapeMeshCache::set_mesh(const btCollisionShape& shape,
+                              std::shared_ptr<const TriangleMesh> mesh) {
+  meshes_[cache_key(shape)] = std::move(mesh);
+}
+
+std::shared_ptr<const TriangleMesh> ShapeMeshCache::mesh_of(const btCollisionShape& shape) {
+  const auto key = cache_key(shape);
   auto it = meshes_.find(key);
   if (it == meshes_.end()) {
     it = meshes_.emplace(key, std::make_shared<const TriangleMesh>(shape_to_mesh(shape))).first;

@@ -62,6 +62,13 @@ class FIGNetDynamicsWorld : public btDiscreteDynamicsWorld {
   // Bullet's drawing, plus each face–face edge of the last step as a line between face centres.
   void debugDrawWorld() override;
 
+  // The triangle mesh (in the shape's local frame, current local scaling) that stands for
+  // `shape` in the graph, instead of the one converted from the shape. A convex hull built from a
+  // mesh has lost the mesh's triangulation and inner vertices, and the model was trained on the
+  // mesh: RigidBodies registers each spec's mesh this way. Throws ConfigError when the mesh does
+  // not fit the shape's bounding box (a wrong frame or scale).
+  void set_shape_mesh(const btCollisionShape& shape, std::shared_ptr<const TriangleMesh> mesh);
+
   double model_time_step() const;
   const FIGNetStepStats& last_step_stats() const;
 

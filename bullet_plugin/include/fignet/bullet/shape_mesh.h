@@ -35,6 +35,8 @@ std::unique_ptr<TriangleMesh> concave_triangles_in_box(const btConcaveShape& sha
 class ShapeMeshCache {
  public:
   std::shared_ptr<const TriangleMesh> mesh_of(const btCollisionShape& shape);
+  // Makes `mesh` the shape's mesh at its current local scaling.
+  void set_mesh(const btCollisionShape& shape, std::shared_ptr<const TriangleMesh> mesh);
   void clear() { meshes_.clear(); }
   size_t size() const { return meshes_.size(); }
 
