@@ -391,7 +391,9 @@ void FIGNetDynamicsWorld::set_shape_mesh(const btCollisionShape& shape,
   impl_->shapes.set_mesh(shape, std::move(mesh));
   // Bodies already seen with this shape pick the mesh up at their next step.
   for (auto& [body, state] : impl_->states) {
-    if (body->getCollisionShape() == &shape) state = {};
+    if (body->getCollisionShape() != &shape) continue;
+    state.mesh = nullptr;
+    state.valid = false;
   }
 }
 
