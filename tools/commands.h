@@ -8,5 +8,6 @@ namespace fignet::cli {
 void add_graph_stats_command(CLI::App& app);
 void add_generate_command(CLI::App& app);
 void add_train_command(CLI::App& app);
+void add_eval_command(CLI::App& app);
 
 }  // namespace fignet::cli

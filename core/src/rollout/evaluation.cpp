@@ -43,6 +43,8 @@ Evaluation evaluate_rollouts(AccelerationPredictor& predictor, std::span<const T
     result.final_rotation += errors.final_rotation;
     if (options.penetration) penetration += penetration_totals(predicted, truth, first);
     result.per_trajectory.push_back(std::move(errors));
+    if (options.on_trajectory)
+      options.on_trajectory(static_cast<int>(result.per_trajectory.size()));
   }
   const double n = static_cast<double>(truths.size());
   for (size_t f = 0; f < result.translation.size(); ++f) {

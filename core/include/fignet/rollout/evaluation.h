@@ -3,6 +3,7 @@
 // ground truth, face–face edges and time per step.
 #pragma once
 
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -14,6 +15,7 @@ namespace fignet {
 struct EvaluationOptions {
   int frames = -1;           // rollout length (all frames when < 0)
   bool penetration = false;  // also measure penetration ratios (costly: winding numbers)
+  std::function<void(int done)> on_trajectory;  // progress: called after each rollout
 };
 
 struct Evaluation {

@@ -1,0 +1,188 @@
+// `fignet eval`: rollouts of one or more models over a test split, next to the ballistic
+// baseline: errors per frame, over the rollout and at its end, penetration against the ground
+// truth, face–face edges and milliseconds per step; a table on the terminal, JSON for scripts.
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <fmt/ranges.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "fignet/error.h"
+#include "fignet/io/model_file.h"
+#include "fignet/io/trajectory_file.h"
+#include "fignet/rollout/evaluation.h"
+#include "progress.h"
+#include "text_file.h"
+
+namespace fignet::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct EvalArgs {
+  std::vector<fs::path> models, data;
+  fs::path json;
+  int frames = -1, max_trajectories = -1, threads = 0;
+  bool baseline = true, penetration = true;
+};
+
+struct Row {
+  std::string name, kind;
+  Evaluation result;
+};
+
+std::string kind_of(const ModelConfig& config) {
+  return config.graph.collisions == CollisionEdges::kFaceFace ? "FIGNet" : "FIGNet-NoFaceCollision";
+}
+
+// Every trajectory of the files, up to `max` (all when < 0), checked to share one time step.
+std::vector<Trajectory> read_test_split(const EvalArgs& args) {
+  std::vector<Trajectory> all;
+  for (const fs::path& file : args.data) {
+    for (Trajectory& t : read_trajectories(file)) all.push_back(std::move(t));
+  }
+  if (all.empty()) throw ConfigError("--data: the files hold no trajectory");
+  if (args.max_trajectories >= 0 && static_cast<int>(all.size()) > args.max_trajectories) {
+    all.resize(static_cast<size_t>(args.max_trajectories));
+  }
+  for (const Trajectory& t : all) {
+    if (std::abs(t.time_step - all[0].time_step) > 1e-9) {
+      throw ConfigError(fmt::format("--data: trajectories with frame steps {} s and {} s",
+                                    all[0].time_step, t.time_step));
+    }
+  }
+  return all;
+}
+
+Row evaluate(const std::string& name, const std::string& kind, AccelerationPredictor& predictor,
+             const std::vector<Trajectory>& test, const EvalArgs& args) {
+  ProgressBar progress(fmt::format("eval {}", name), static_cast<long long>(test.size()));
+  EvaluationOptions options;
+  options.frames = args.frames;
+  options.penetration = args.penetration;
+  options.on_trajectory = [&](int done) { progress.update(done); };
+  Row row{name, kind, evaluate_rollouts(predictor, test, options)};
+  progress.finish(static_cast<long long>(test.size()));
+  return row;
+}
+
+void print_table(const std::vector<Row>& rows) {
+  fmt::print("\n{:<34} {:>21} {:>21} {:>15} {:>10} {:>8}\n", "", "translation (m)",
+             "rotation (deg)", "penetration", "face-face", "");
+  fmt::print("{:<34} {:>10} {:>10} {:>10} {:>10} {:>7} {:>7} {:>10} {:>8}\n", "run", "mean", "last",
+             "mean", "last", "depth", "count", "edges", "ms/step");
+  for (const Row& row : rows) {
+    const Evaluation& e = row.result;
+    fmt::print(
+        "{:<34} {:>10.4f} {:>10.4f} {:>10.2f} {:>10.2f} {:>7.2f} {:>7.2f} {:>10.1f} {:>8.3f}\n",
+        fmt::format("{} ({})", row.name, row.kind), e.mean_translation, e.final_translation,
+        e.mean_rotation, e.final_rotation, e.penetration_depth_ratio, e.penetration_count_ratio,
+        e.face_edges_per_step, e.milliseconds_per_step);
+  }
+  fmt::print(
+      "\nmean: over each rollout's predicted frames, then over trajectories; last: the final "
+      "frame. Penetration: ratio to the ground truth's (1 = as much as Bullet; nan: not measured "
+      "or none in the ground truth).\n");
+}
+
+nlohmann::json to_json(const Row& row) {
+  const Evaluation& e = row.result;
+  const auto number = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nullptr; };
+  nlohmann::json per_trajectory = nlohmann::json::array();
+  for (const RolloutErrors& t : e.per_trajectory) {
+    per_trajectory.push_back({{"mean_translation_m", t.mean_translation},
+                              {"final_translation_m", t.final_translation},
+                              {"mean_rotation_deg", t.mean_rotation},
+                              {"final_rotation_deg", t.final_rotation}});
+  }
+  return {{"name", row.name},
+          {"kind", row.kind},
+          {"trajectories", e.trajectories},
+          {"mean_translation_m", e.mean_translation},
+          {"final_translation_m", e.final_translation},
+          {"mean_rotation_deg", e.mean_rotation},
+          {"final_rotation_deg", e.final_rotation},
+          {"penetration_depth_ratio", number(e.penetration_depth_ratio)},
+          {"penetration_count_ratio", number(e.penetration_count_ratio)},
+          {"face_edges_per_step", e.face_edges_per_step},
+          {"milliseconds_per_step", e.milliseconds_per_step},
+          {"translation_per_frame_m", e.translation},
+          {"rotation_per_frame_deg", e.rotation},
+          {"per_trajectory", per_trajectory}};
+}
+
+void run_eval(const EvalArgs& args) {
+  if (args.threads > 0) omp_set_num_threads(args.threads);
+  const std::vector<Trajectory> test = read_test_split(args);
+  std::vector<Row> rows;
+  int history = 2;
+  for (const fs::path& file : args.models) {
+    auto model = std::make_shared<const Model>(load_model(file));
+    const ModelConfig& config = model->config();
+    if (std::abs(config.time_step - test[0].time_step) > 1e-9) {
+      throw ConfigError(fmt::format("--model '{}': trained with steps of {} s, the data has {} s",
+                                    file.string(), config.time_step, test[0].time_step));
+    }
+    history = config.graph.history;
+    ModelPredictor predictor(model);
+    rows.push_back(evaluate(file.string(), kind_of(config), predictor, test, args));
+  }
+  if (args.baseline) {
+    // Constant velocity under gravity from the same given frames: what no contact model gives.
+    GravityPredictor ballistic(test[0].gravity, test[0].time_step, history);
+    rows.push_back(evaluate("ballistic", "constant velocity + gravity", ballistic, test, args));
+  }
+  std::vector<std::string> files;
+  for (const fs::path& file : args.data) files.push_back(file.string());
+  fmt::print("{} trajectories, {} frames each ({} given), from {}\n", test.size(),
+             args.frames > 0 ? args.frames : test[0].num_frames(), history + 1,
+             fmt::join(files, ", "));
+  print_table(rows);
+  if (!args.json.empty()) {
+    nlohmann::json out = {{"data", nlohmann::json::array()},
+                          {"trajectories", test.size()},
+                          {"given_frames", history + 1},
+                          {"frame_step_s", test[0].time_step},
+                          {"runs", nlohmann::json::array()}};
+    out["data"] = files;
+    for (const Row& row : rows) out["runs"].push_back(to_json(row));
+    write_text_atomically(args.json, out.dump(2) + "\n");
+    fmt::print("results: {}\n", args.json.string());
+  }
+}
+
+}  // namespace
+
+void add_eval_command(CLI::App& app) {
+  auto args = std::make_shared<EvalArgs>();
+  auto* cmd = app.add_subcommand(
+      "eval",
+      "Roll models out over a test split: translation and rotation errors, penetration, "
+      "face-face edges and time per step, next to the ballistic baseline");
+  cmd->add_option("--model", args->models,
+                  "Model file (repeat to compare several, e.g. FIGNet and its NoFaceCollision "
+                  "ablation)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--data", args->data, "Trajectory file(s) of the test split")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--json", args->json, "Also write every figure, per frame and per trajectory");
+  cmd->add_option("--frames", args->frames, "Rollout length in frames (default: all)")
+      ->check(CLI::Range(4, 100000));
+  cmd->add_option("--max-trajectories", args->max_trajectories,
+                  "Use only the first N trajectories (default: all)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("!--no-baseline", args->baseline, "Leave out the ballistic baseline");
+  cmd->add_flag("!--no-penetration", args->penetration,
+                "Skip the penetration ratios (the costliest metric)");
+  cmd->add_option("--threads", args->threads, "OpenMP threads (0: every core)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->callback([args] { run_eval(*args); });
+}
+
+}  // namespace fignet::cli
