@@ -3,7 +3,6 @@
 // native Bullet and the 1e-6 m chaos floor; a speed–accuracy table on the terminal, and a
 // self-contained HTML report with a 3D player, error plots and the speed–accuracy chart.
 #include <fmt/format.h>
-#include <omp.h>
 
 #include <filesystem>
 
@@ -25,7 +24,7 @@ namespace fs = std::filesystem;
 struct CompareArgs {
   std::vector<fs::path> models;
   fs::path data, report = "fignet-report.html", json;
-  int max_scenes = 5, frames = -1, threads = 0;
+  int max_scenes = 5, frames = -1, threads = 1;
 };
 
 void print_table(const std::vector<bullet::RunResult>& results) {
@@ -47,7 +46,6 @@ void print_table(const std::vector<bullet::RunResult>& results) {
 }
 
 void run_compare(const CompareArgs& args) {
-  if (args.threads > 0) omp_set_num_threads(args.threads);
   std::vector<Trajectory> recorded = read_trajectories(args.data);
   if (static_cast<int>(recorded.size()) > args.max_scenes) recorded.resize(args.max_scenes);
   std::vector<bullet::SceneSpec> scenes;
@@ -67,7 +65,8 @@ void run_compare(const CompareArgs& args) {
                       file.string(), step, scenes[0].frame_step()));
     }
   }
-  const std::vector<bullet::ComparisonRun> runs = bullet::standard_runs(models, names);
+  std::vector<bullet::ComparisonRun> runs = bullet::standard_runs(models, names);
+  for (bullet::ComparisonRun& run : runs) run.world_options.threads = args.threads;
   ProgressBar progress("compare", static_cast<long long>(runs.size() * scenes.size()));
   const std::vector<bullet::RunResult> results =
       bullet::compare_runs(scenes, runs, [&](int run, int scene) {
@@ -113,7 +112,10 @@ void add_compare_command(CLI::App& app) {
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--frames", args->frames, "Simulate N frames (default: the file's)")
       ->check(CLI::Range(2, 100000));
-  cmd->add_option("--threads", args->threads, "OpenMP threads for the network (0: every core)")
+  cmd->add_option("--threads", args->threads,
+                  "Threads for the network's matrix products (0: every core; more than one "
+                  "only helps large scenes on an otherwise idle machine)")
+      ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->callback([args] { run_compare(*args); });
 }

@@ -51,20 +51,24 @@ std::vector<ComparisonRun> standard_runs(const std::vector<std::shared_ptr<const
     throw ConfigError("standard_runs: one name per model");
   }
   std::vector<ComparisonRun> runs;
-  runs.push_back({"Bullet 240 Hz", "ground truth", {}, nullptr, 0.0});
+  runs.push_back({"Bullet 240 Hz", "ground truth", {}, nullptr, 0.0, {}});
   for (size_t i = 0; i < models.size(); ++i) {
     SolverSettings one_step_per_frame;
     one_step_per_frame.steps_per_frame = 1;
-    runs.push_back(
-        {fmt::format("FIGNet {}", model_names[i]), "FIGNet", one_step_per_frame, models[i], 0.0});
+    runs.push_back({fmt::format("FIGNet {}", model_names[i]),
+                    "FIGNet",
+                    one_step_per_frame,
+                    models[i],
+                    0.0,
+                    {}});
   }
   SolverSettings coarse;
   coarse.steps_per_frame = 1;
-  runs.push_back({"Bullet 48 Hz", "Bullet", coarse, nullptr, 0.0});
+  runs.push_back({"Bullet 48 Hz", "Bullet", coarse, nullptr, 0.0, {}});
   SolverSettings few_iterations;
   few_iterations.iterations = 2;
-  runs.push_back({"Bullet 240 Hz, 2 iterations", "Bullet", few_iterations, nullptr, 0.0});
-  runs.push_back({"Bullet 240 Hz, start moved 1e-6 m", "chaos floor", {}, nullptr, 1e-6});
+  runs.push_back({"Bullet 240 Hz, 2 iterations", "Bullet", few_iterations, nullptr, 0.0, {}});
+  runs.push_back({"Bullet 240 Hz, start moved 1e-6 m", "chaos floor", {}, nullptr, 1e-6, {}});
   return runs;
 }
 
@@ -84,10 +88,11 @@ SceneSpec perturbed(SceneSpec spec, double distance) {
 WorldFactory world_for(const ComparisonRun& run) {
   if (!run.model) return {};
   std::shared_ptr<const Model> model = run.model;
-  return [model](btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
-                 btConstraintSolver* solver, btCollisionConfiguration* configuration) {
+  const FIGNetWorldOptions options = run.world_options;
+  return [model, options](btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
+                          btConstraintSolver* solver, btCollisionConfiguration* configuration) {
     return std::make_unique<FIGNetDynamicsWorld>(dispatcher, broadphase, solver, configuration,
-                                                 model);
+                                                 model, options);
   };
 }
 

@@ -336,8 +336,9 @@ FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
                                          std::shared_ptr<const Model> model,
                                          const FIGNetWorldOptions& options)
     : FIGNetDynamicsWorld(dispatcher, broadphase, solver, configuration,
-                          std::make_unique<ModelPredictor>(model), model->config().graph,
-                          model->config().time_step, model->config().gravity, options) {}
+                          std::make_unique<ModelPredictor>(model, options.threads),
+                          model->config().graph, model->config().time_step, model->config().gravity,
+                          options) {}
 
 FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
                                          btBroadphaseInterface* broadphase,

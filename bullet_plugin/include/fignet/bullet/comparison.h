@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "fignet/bullet/bullet_simulation.h"
+#include "fignet/bullet/fignet_dynamics_world.h"
 #include "fignet/model/model.h"
 #include "fignet/rollout/metrics.h"
 
@@ -25,6 +26,7 @@ struct ComparisonRun {
   SolverSettings settings;
   std::shared_ptr<const Model> model;  // set: a FIGNetDynamicsWorld with this model
   double perturbation = 0.0;           // metres, random direction per dynamic body
+  FIGNetWorldOptions world_options;    // for model runs
 };
 
 // Ground truth first, then one run per model, Bullet at 48 Hz, Bullet at 240 Hz with 2 solver

@@ -29,6 +29,9 @@ struct FIGNetWorldOptions {
   // Broadphase boxes grow by d_c plus the distance a body moved in its last step, so a fast body
   // still finds what it is about to hit (false: d_c only, as in training).
   bool grow_search_by_travel = true;
+  // Threads for the network's matrix products (see ModelPredictor; 0: every core). One keeps
+  // a step from stalling behind the host program's own threads.
+  int threads = 1;
 };
 
 // What the last internal step simulated and what it cost.

@@ -34,7 +34,10 @@ class AccelerationPredictor {
 // Runs a FIGNet model: builds the graph, runs the network, un-normalises. One per thread.
 class ModelPredictor : public AccelerationPredictor {
  public:
-  explicit ModelPredictor(std::shared_ptr<const Model> model);
+  // `threads` for Eigen's matrix products (0: Eigen's default, every core). One by default: a
+  // step's products are small, and threads that wait for a core another program holds stall
+  // each product by a scheduler time slice, which made steps many times slower on a busy machine.
+  explicit ModelPredictor(std::shared_ptr<const Model> model, int threads = 1);
   int history() const override { return model_->config().graph.history; }
   void predict(const Scene& scene, Points& accelerations) override;
   void predict_with_candidates(const Scene& scene, std::span<const ObjectPair> candidates,
@@ -53,6 +56,7 @@ class ModelPredictor : public AccelerationPredictor {
   Graph graph_;
   NetworkWorkspace workspace_;
   RowMatrixXf denormalized_;
+  int threads_ = 1;
 };
 
 // Exact free fall: every node accelerates by gravity·dt² (the ballistic baseline without
