@@ -21,7 +21,7 @@ done
 
 scripts/install-deps.sh
 cmake --preset release >/dev/null
-cmake --build --preset release
+cmake --build --preset release --target fignet  # the tool only: tests and benchmarks are not needed here
 mkdir -p out/demo
 fignet=build/release/tools/fignet
 "$fignet" generate --preset movi-a --count "$scenes" --seed 3 --out out/demo/scenes.h5
