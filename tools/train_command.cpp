@@ -180,13 +180,14 @@ void add_train_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--valid", args->valid, "Held-out trajectory file for validation rollouts")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--preset", args->preset,
-                  "Model preset: paper (L=128, M=10) or small (L=64, M=5)")
-      ->check(CLI::IsMember(ModelConfig::preset_names()))
-      ->capture_default_str();
-  cmd->add_option("--config", args->config_file, "JSON file of config fields (see --set)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option(
+  auto* preset = cmd->add_option("--preset", args->preset,
+                                 "Model preset: paper (L=128, M=10) or small (L=64, M=5)")
+                     ->check(CLI::IsMember(ModelConfig::preset_names()))
+                     ->capture_default_str();
+  auto* config =
+      cmd->add_option("--config", args->config_file, "JSON file of config fields (see --set)")
+          ->check(CLI::ExistingFile);
+  auto* settings = cmd->add_option(
       "--set", args->settings, "Override one config field, key=value (repeatable). Fields: " + [] {
         std::string names;
         for (const auto& n : TrainingConfig::field_names())
@@ -198,8 +199,13 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "Model file written at every checkpoint and at the end")
       ->required();
   cmd->add_option("--checkpoint", args->checkpoint, "Checkpoint file (default: OUT.ckpt.h5)");
+  // A resumed run keeps its checkpoint's config (anything else would not be the same run).
   cmd->add_flag("--resume", args->resume,
-                "Continue the run in the checkpoint file exactly where it stopped");
+                "Continue the run in the checkpoint file exactly where it stopped, with its "
+                "config (only --steps may change)")
+      ->excludes(preset)
+      ->excludes(config)
+      ->excludes(settings);
   cmd->add_option("--checkpoint-minutes", args->checkpoint_minutes, "Minutes between checkpoints")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
