@@ -15,9 +15,15 @@ Normalizer::Normalizer(int size, std::int64_t max_accumulations)
 void Normalizer::accumulate(const ConstMatrixRef& rows) {
   if (frozen() || rows.rows() == 0) return;
   const Eigen::MatrixXd values = rows.cast<double>();
-  sum_ += values.colwise().sum().transpose();
-  sum_squares_ += values.array().square().colwise().sum().matrix().transpose();
-  count_ += static_cast<double>(rows.rows());
+  add(static_cast<double>(rows.rows()), values.colwise().sum().transpose(),
+      values.array().square().colwise().sum().matrix().transpose());
+}
+
+void Normalizer::add(double count, const Eigen::VectorXd& sum, const Eigen::VectorXd& sum_squares) {
+  if (frozen() || count == 0.0) return;
+  sum_ += sum;
+  sum_squares_ += sum_squares;
+  count_ += count;
   ++accumulations_;
   update_cache();
 }

@@ -3,20 +3,36 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <sstream>
 
 #include "fignet/error.h"
 
 namespace fignet {
 
+namespace {
+
+// One process: sums are the values themselves.
+Collective& single_process() {
+  static Collective one;
+  return one;
+}
+
+// The inputs' and targets' normalisers in one fixed order.
+std::vector<Normalizer*> all_of(Normalizers& n) {
+  std::vector<Normalizer*> all = {&n.mesh_node, &n.object_node, &n.face_edge, &n.target};
+  for (Normalizer& edge : n.edges) all.push_back(&edge);
+  return all;
+}
+
+}  // namespace
+
 Trainer::Trainer(const ModelConfig& config, const TrainerConfig& trainer_config,
-                 const std::vector<Trajectory>& data, const Model* initial)
+                 const std::vector<Trajectory>& data, const Model* initial, Collective* collective)
     : config_(config),
       trainer_config_(trainer_config),
       data_(data),
       network_(config),
       normalizers_(network_.make_normalizers()),
-      rng_(trainer_config.seed),
+      collective_(collective ? collective : &single_process()),
       builder_(config.graph) {
   if (trainer_config.batch_size < 1) {
     throw ConfigError(
@@ -26,8 +42,12 @@ Trainer::Trainer(const ModelConfig& config, const TrainerConfig& trainer_config,
   samples_ = enumerate_samples(data_, config.graph.history);
   if (samples_.empty()) {
     throw ConfigError(
-        fmt::format("trainer: no training samples: every trajectory needs more than "
+        fmt::format("trainer: no training samples{}: every trajectory needs more than "
                     "history + 1 = {} frames",
+                    collective_->size() > 1
+                        ? fmt::format(" in the share of process {} of {} ({} trajectories)",
+                                      collective_->rank(), collective_->size(), data_.size())
+                        : "",
                     config.graph.history + 1));
   }
   if (initial) {
@@ -40,60 +60,119 @@ Trainer::Trainer(const ModelConfig& config, const TrainerConfig& trainer_config,
   adam_ = Adam(params_.size(), trainer_config.adam);
 }
 
-void Trainer::prepare_batch(const std::vector<SampleRef>& batch, bool accumulate) {
+int Trainer::local_batch_size(int batch) const {
+  const int n = collective_->size(), r = collective_->rank();
+  return batch / n + (r < batch % n ? 1 : 0);
+}
+
+std::mt19937_64 Trainer::step_generator(std::int64_t step) const {
+  const auto seed = trainer_config_.seed;
+  std::seed_seq sequence{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
+                         static_cast<std::uint32_t>(collective_->rank()),
+                         static_cast<std::uint32_t>(step),
+                         static_cast<std::uint32_t>(static_cast<std::uint64_t>(step) >> 32)};
+  return std::mt19937_64(sequence);
+}
+
+void Trainer::prepare_batch(const std::vector<SampleRef>& batch, std::mt19937_64& noise,
+                            bool accumulate) {
   const int h = config_.graph.history;
   scenes_.resize(batch.size());
   scene_targets_.resize(batch.size());
   for (size_t b = 0; b < batch.size(); ++b) {
-    make_noisy_sample(data_[batch[b].trajectory], batch[b].frame, h, config_.noise_std, rng_,
+    if (batch[b].trajectory < 0 || batch[b].trajectory >= static_cast<int>(data_.size())) {
+      throw ConfigError(fmt::format("trainer: sample of trajectory {} (this process has {})",
+                                    batch[b].trajectory, data_.size()));
+    }
+    make_noisy_sample(data_[batch[b].trajectory], batch[b].frame, h, config_.noise_std, noise,
                       scenes_[b], scene_targets_[b]);
   }
   builder_.build(scenes_, graph_);
   gather_targets(graph_, scene_targets_, targets_, in_loss_);
-  if (!accumulate) return;
-  // Statistics of every input block and of the dynamic nodes' targets (MeshGraphNets style).
-  network_.accumulate_input_statistics(graph_, normalizers_);
+  if (accumulate) accumulate_statistics();
+}
+
+void Trainer::accumulate_statistics() {
+  // Every process freezes at the same step: they all add the same sums.
+  if (normalizers_.target.frozen()) return;
+  // This batch's statistics (MeshGraphNets style: every input block, and the dynamic nodes'
+  // targets), counted from zero, ...
+  batch_statistics_ = network_.make_normalizers();
+  network_.accumulate_input_statistics(graph_, batch_statistics_);
   RowMatrixXf dynamic_targets(std::count(in_loss_.begin(), in_loss_.end(), 1), 3);
   for (Eigen::Index i = 0, r = 0; i < targets_.rows(); ++i) {
     if (in_loss_[i]) dynamic_targets.row(r++) = targets_.row(i);
   }
-  normalizers_.target.accumulate(dynamic_targets);
+  batch_statistics_.target.accumulate(dynamic_targets);
+  // ... summed over processes in one flat buffer (count, sums, sums of squares per normaliser),
+  statistics_buffer_.clear();
+  for (Normalizer* n : all_of(batch_statistics_)) {
+    statistics_buffer_.push_back(n->count());
+    statistics_buffer_.insert(statistics_buffer_.end(), n->sum().begin(), n->sum().end());
+    statistics_buffer_.insert(statistics_buffer_.end(), n->sum_squares().begin(),
+                              n->sum_squares().end());
+  }
+  collective_->sum(statistics_buffer_);
+  // ... and added: one accumulation per step, however many processes.
+  size_t at = 0;
+  for (Normalizer* n : all_of(normalizers_)) {
+    const double count = statistics_buffer_[at++];
+    const Eigen::Map<const Eigen::VectorXd> sum(&statistics_buffer_[at], n->size());
+    const Eigen::Map<const Eigen::VectorXd> squares(&statistics_buffer_[at + n->size()], n->size());
+    at += 2 * static_cast<size_t>(n->size());
+    n->add(count, sum, squares);
+  }
 }
 
-double Trainer::loss_and_gradient(bool with_gradient) {
+double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
   const ConstMatrixView output =
       network_.forward(params_.data(), normalizers_, graph_, workspace_, with_gradient);
   normalized_targets_.resize(targets_.rows(), 3);
   normalizers_.target.normalize(targets_, normalized_targets_);
-  const auto count = std::count(in_loss_.begin(), in_loss_.end(), 1);
-  if (count == 0) return 0.0;
-  d_output_.setZero(output.rows(), 3);
-  double loss = 0.0;
-  const float scale = 2.0f / static_cast<float>(3 * count);
+  double local_squares = 0.0;
   for (Eigen::Index i = 0; i < output.rows(); ++i) {
     if (!in_loss_[i]) continue;
     for (int c = 0; c < 3; ++c) {
-      const float error = output(i, c) - normalized_targets_(i, c);
-      loss += static_cast<double>(error) * error;
-      d_output_(i, c) = scale * error;
+      const double error = output(i, c) - normalized_targets_(i, c);
+      local_squares += error * error;
     }
   }
-  loss /= static_cast<double>(3 * count);
+  // The mean is over every process's dynamic nodes: one small sum for the count and loss.
+  double totals[2] = {static_cast<double>(std::count(in_loss_.begin(), in_loss_.end(), 1)),
+                      local_squares};
+  if (reduce) collective_->sum(totals);
+  const double count = totals[0];
+  if (count == 0) return 0.0;
   if (with_gradient) {
+    d_output_.setZero(output.rows(), 3);
+    const float scale = 2.0f / static_cast<float>(3 * count);
+    for (Eigen::Index i = 0; i < output.rows(); ++i) {
+      if (!in_loss_[i]) continue;
+      for (int c = 0; c < 3; ++c)
+        d_output_(i, c) = scale * (output(i, c) - normalized_targets_(i, c));
+    }
     std::fill(grads_.begin(), grads_.end(), 0.0f);
     network_.backward(params_.data(), grads_.data(), graph_, d_output_, workspace_);
+    // Each process's gradient is its part of the global mean's: their sum is the whole.
+    if (reduce) collective_->sum(std::span<float>(grads_.data(), grads_.size()));
   }
-  return loss;
+  return totals[1] / (3 * count);
 }
 
 TrainStep Trainer::step() {
+  std::mt19937_64 generator = step_generator(adam_.step());
   std::uniform_int_distribution<size_t> pick(0, samples_.size() - 1);
-  batch_.resize(trainer_config_.batch_size);
-  for (SampleRef& sample : batch_) sample = samples_[pick(rng_)];
-  prepare_batch(batch_, /*accumulate=*/true);
+  batch_.resize(static_cast<size_t>(local_batch_size(trainer_config_.batch_size)));
+  for (SampleRef& sample : batch_) sample = samples_[pick(generator)];
+  return step_on(batch_, generator());
+}
+
+TrainStep Trainer::step_on(const std::vector<SampleRef>& samples, std::uint64_t noise_seed) {
+  std::mt19937_64 noise(noise_seed);
+  prepare_batch(samples, noise, /*accumulate=*/true);
   TrainStep result;
   result.learning_rate = adam_.learning_rate();
-  result.loss = loss_and_gradient(true);
+  result.loss = loss_and_gradient(true, true);
   adam_.update(params_, grads_);
   result.step = adam_.step();
   return result;
@@ -107,14 +186,13 @@ void Trainer::run(std::int64_t steps, const std::function<bool(const TrainStep&)
 }
 
 double Trainer::evaluate_loss(const std::vector<SampleRef>& samples) {
-  prepare_batch(samples, /*accumulate=*/false);
-  return loss_and_gradient(false);
+  std::mt19937_64 noise = step_generator(adam_.step());
+  prepare_batch(samples, noise, /*accumulate=*/false);
+  return loss_and_gradient(false, false);
 }
 
 TrainerState Trainer::state() const {
-  std::ostringstream rng;
-  rng << rng_;
-  return {adam_.step(), adam_.first_moment(), adam_.second_moment(), rng.str()};
+  return {adam_.step(), adam_.first_moment(), adam_.second_moment(), ""};
 }
 
 void Trainer::restore(const TrainerState& state) {
@@ -123,9 +201,6 @@ void Trainer::restore(const TrainerState& state) {
                                   state.first_moment.size(), state.second_moment.size(),
                                   params_.size()));
   }
-  std::istringstream rng(state.rng);
-  rng >> rng_;
-  if (!rng) throw ConfigError("trainer: the random generator state cannot be parsed");
   adam_.first_moment() = state.first_moment;
   adam_.second_moment() = state.second_moment;
   adam_.set_step(state.step);

@@ -18,6 +18,9 @@ class Normalizer {
 
   // Adds the rows' statistics, counting one accumulation; does nothing once frozen.
   void accumulate(const ConstMatrixRef& rows);
+  // The same with the statistics already summed (over the processes of data-parallel training):
+  // `count` rows whose columns sum to `sum` and their squares to `sum_squares`.
+  void add(double count, const Eigen::VectorXd& sum, const Eigen::VectorXd& sum_squares);
   bool frozen() const { return accumulations_ >= max_accumulations_; }
 
   // out = (in − mean)/std. Columns that never varied are only centred (std taken as 1), so a

@@ -1,6 +1,9 @@
 // Training FIGNet on trajectories: batches of noisy samples concatenated into one graph, forward,
 // MSE in normalised target space over dynamic nodes, backward, Adam. Deterministic for a given
-// seed and thread count.
+// seed, thread count and process count. Data-parallel over a Collective: each process holds its
+// share of the trajectories and draws its share of every global batch; statistics, the node
+// count of the loss and the gradient are summed across processes, so Adam runs identically
+// everywhere.
 #pragma once
 
 #include <cstdint>
@@ -13,22 +16,24 @@
 #include "fignet/graph/graph_builder.h"
 #include "fignet/model/model.h"
 #include "fignet/nn/adam.h"
+#include "fignet/train/collective.h"
 #include "fignet/train/training_batch.h"
 
 namespace fignet {
 
 struct TrainerConfig {
-  int batch_size = 4;  // scenes per step, concatenated into one graph
+  int batch_size = 4;  // scenes per step over all processes, concatenated into graphs
   AdamConfig adam;     // learning rate 1e-3 → 1e-4 over adam.decay_steps
   std::uint64_t seed = 1;
 };
 
 // Everything besides the model that makes training continue exactly where it stopped: the
-// optimizer's moments and step count and the sampling/noise generator's state.
+// optimizer's moments and step count. Sampling needs no state: each step's generator is seeded
+// from (seed, process, step), so a resumed run draws what the uninterrupted one would have.
 struct TrainerState {
   std::int64_t step = 0;
   std::vector<float> first_moment, second_moment;
-  std::string rng;  // std::mt19937_64 in its standard text form
+  std::string rng;  // unused since sampling is counter-based; kept for older checkpoints
 };
 
 struct TrainStep {
@@ -39,15 +44,22 @@ struct TrainStep {
 
 class Trainer {
  public:
-  // Trains a fresh model of `config` (or continues `initial`) on `data`, which must outlive it.
+  // Trains a fresh model of `config` (or continues `initial`) on `data`, which must outlive it:
+  // all the trajectories, or this process's share of them when `collective` spans several
+  // processes (then every process must construct its Trainer alike, and `collective` outlive it).
   Trainer(const ModelConfig& config, const TrainerConfig& trainer_config,
-          const std::vector<Trajectory>& data, const Model* initial = nullptr);
+          const std::vector<Trajectory>& data, const Model* initial = nullptr,
+          Collective* collective = nullptr);
 
-  // One optimisation step on a random batch.
+  // One optimisation step on a random batch (this process's share of it).
   TrainStep step();
+  // One step on the given samples of this process's data, with noise from `noise_seed`: what
+  // step() does after drawing them. Every process calls it together.
+  TrainStep step_on(const std::vector<SampleRef>& samples, std::uint64_t noise_seed);
   // Runs `steps` steps; `on_step` sees each result and may stop early by returning false.
   void run(std::int64_t steps, const std::function<bool(const TrainStep&)>& on_step);
-  // The loss of one batch without updating anything (noise included, as in training).
+  // The loss of one batch of this process's data, without updating anything or communicating
+  // (noise included, as in training).
   double evaluate_loss(const std::vector<SampleRef>& samples);
 
   // An immutable snapshot of the current parameters and statistics.
@@ -61,16 +73,21 @@ class Trainer {
   void restore(const TrainerState& state);
   const TrainerConfig& trainer_config() const { return trainer_config_; }
 
-  // State for data-parallel training.
-  std::vector<float>& parameters() { return params_; }
-  Adam& optimizer() { return adam_; }
-  Normalizers& normalizers() { return normalizers_; }
-  std::mt19937_64& rng() { return rng_; }
+  const std::vector<float>& parameters() const { return params_; }
+  const Adam& optimizer() const { return adam_; }
+  const Normalizers& normalizers() const { return normalizers_; }
+  // This process's share of a global batch of `batch` samples.
+  int local_batch_size(int batch) const;
 
  private:
   // Builds the batch graph and targets; accumulates statistics while they are not frozen.
-  void prepare_batch(const std::vector<SampleRef>& batch, bool accumulate);
-  double loss_and_gradient(bool with_gradient);
+  void prepare_batch(const std::vector<SampleRef>& batch, std::mt19937_64& noise, bool accumulate);
+  // Adds this step's statistics of every input and of the targets, summed over processes.
+  void accumulate_statistics();
+  // Mean over every process's dynamic nodes; with `reduce`, counts and gradients are summed
+  // over processes.
+  double loss_and_gradient(bool with_gradient, bool reduce);
+  std::mt19937_64 step_generator(std::int64_t step) const;
 
   ModelConfig config_;
   TrainerConfig trainer_config_;
@@ -80,7 +97,7 @@ class Trainer {
   AlignedFloats grads_;  // aligned: reductions into it then sum in an address-independent order
   Normalizers normalizers_;
   Adam adam_;
-  std::mt19937_64 rng_;
+  Collective* collective_;
   std::vector<SampleRef> samples_, batch_;
   // Scratch reused every step.
   GraphBuilder builder_;
@@ -90,6 +107,8 @@ class Trainer {
   RowMatrixXf targets_, normalized_targets_, d_output_;
   std::vector<std::uint8_t> in_loss_;
   NetworkWorkspace workspace_;
+  Normalizers batch_statistics_;
+  std::vector<double> statistics_buffer_;
 };
 
 }  // namespace fignet
