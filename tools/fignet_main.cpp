@@ -4,9 +4,14 @@
 #include <Eigen/Core>
 #include <cstdio>
 #include <exception>
+#include <memory>
 
 #include "commands.h"
 #include "fignet/error.h"
+#include "process_group.h"
+#ifdef FIGNET_WITH_MPI
+#include "fignet/parallel/mpi_collective.h"
+#endif
 
 #ifndef FIGNET_VERSION
 #define FIGNET_VERSION "unknown"
@@ -30,7 +35,32 @@ void add_info_command(CLI::App& app) {
 
 }  // namespace
 
+namespace fignet::cli {
+ProcessGroup& process_group() {
+  static ProcessGroup group;
+  return group;
+}
+}  // namespace fignet::cli
+
 int main(int argc, char** argv) {
+  // Under mpirun every process runs this program; alone it is one process and MPI stays idle.
+  fignet::Collective one_process;
+  fignet::cli::process_group().collective = &one_process;
+#ifdef FIGNET_WITH_MPI
+  fignet::MpiSession mpi(&argc, &argv);
+  std::unique_ptr<fignet::MpiCollective> processes;
+  if (mpi.active()) {
+    processes = std::make_unique<fignet::MpiCollective>();
+    fignet::cli::process_group().collective = processes.get();
+  }
+  // One process failing would leave the others waiting in a collective: end them all.
+  const auto fail = [&](int code) {
+    if (fignet::cli::process_group().size() > 1) mpi.abort(code);
+    return code;
+  };
+#else
+  const auto fail = [](int code) { return code; };
+#endif
   CLI::App app{
       "FIGNet: learned rigid-body simulation (Face Interaction Graph Networks) for Bullet"};
   app.require_subcommand(1);
@@ -47,10 +77,10 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const fignet::Error& e) {
     std::fprintf(stderr, "fignet: error: %s\n", e.what());
-    return 1;
+    return fail(1);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fignet: unexpected error: %s\n", e.what());
-    return 1;
+    return fail(1);
   }
   return 0;
 }

@@ -8,6 +8,8 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <optional>
+#include <span>
 
 #include "commands.h"
 #include "fignet/error.h"
@@ -16,6 +18,7 @@
 #include "fignet/io/trajectory_file.h"
 #include "fignet/rollout/evaluation.h"
 #include "fignet/train/training_config.h"
+#include "process_group.h"
 #include "progress.h"
 #include "training_log.h"
 
@@ -84,9 +87,14 @@ void run_train(const TrainArgs& args) {
           fmt::format("'{}': folder '{}' does not exist", file.string(), parent.string()));
     }
   }
-  const std::vector<Trajectory> data = read_trajectories(args.data);
+  // Under mpirun each process reads its share of the trajectories; process 0 alone validates,
+  // prints, logs and writes checkpoints.
+  const ProcessGroup& group = process_group();
+  const bool root = group.is_root();
+  const std::vector<Trajectory> data =
+      read_trajectories(args.data, TrajectoryShare{group.rank(), group.size()});
   std::vector<Trajectory> valid;
-  if (!args.valid.empty()) {
+  if (root && !args.valid.empty()) {
     valid = read_trajectories(args.valid);
     valid.resize(std::min<size_t>(valid.size(), args.valid_trajectories));
   }
@@ -106,38 +114,58 @@ void run_train(const TrainArgs& args) {
                                                   : std::max(steps, checkpoint.state.step);
     initial = checkpoint.model;
     state = std::move(checkpoint.state);
-    fmt::print("resuming {} at step {}\n", checkpoint_path.string(), state.step);
+    if (root) fmt::print("resuming {} at step {}\n", checkpoint_path.string(), state.step);
   } else {
     adopt_physics(data, config.model);
   }
   config.validate();
-  fmt::print("config:\n{}\n", config.to_json());
-  fmt::print("data: {} trajectories; validation: {} trajectories\n", data.size(), valid.size());
+  if (config.trainer.batch_size < group.size()) {
+    throw ConfigError(
+        fmt::format("batch_size = {} is smaller than the {} processes: each needs "
+                    "at least one sample per step",
+                    config.trainer.batch_size, group.size()));
+  }
+  if (root) {
+    fmt::print("config:\n{}\n", config.to_json());
+    fmt::print("data: {} trajectories{}; validation: {} trajectories\n", data.size(),
+               group.size() > 1 ? fmt::format(" on process 0 of {}", group.size()) : "",
+               valid.size());
+  }
 
-  Trainer trainer(config.model, config.trainer, data, initial.get());
+  Trainer trainer(config.model, config.trainer, data, initial.get(), group.collective);
   if (args.resume) trainer.restore(state);
-  TrainingLog log(log_path, trainer.steps_done());
+  std::optional<TrainingLog> log;
+  if (root) log.emplace(log_path, trainer.steps_done());
 
   stop_requested = 0;
   std::signal(SIGINT, request_stop);
   std::signal(SIGTERM, request_stop);
   auto save = [&] {
+    if (!root) return;  // every process holds the same model and optimizer state
     save_checkpoint(trainer, checkpoint_path, config.steps);
     save_model(*trainer.model(), args.out);
   };
-  ProgressBar bar("train", config.steps, trainer.steps_done());
+  // Processes stop together, at the same step, or the others would wait in a sum forever.
+  auto stop_agreed = [&] {
+    double stop = stop_requested ? 1.0 : 0.0;
+    if (group.size() > 1) group.collective->sum(std::span<double>(&stop, 1));
+    return stop > 0.0;
+  };
+  ProgressBar bar(root ? "train" : "", config.steps, trainer.steps_done());
   auto last_checkpoint = std::chrono::steady_clock::now();
   double loss_sum = 0.0;
   int loss_count = 0;
   std::int64_t window_start_step = trainer.steps_done();
   double window_start_time = bar.seconds();
-  while (trainer.steps_done() < config.steps && !stop_requested) {
+  bool stopped = false;
+  while (trainer.steps_done() < config.steps && !(stopped = stop_agreed())) {
     const TrainStep step = trainer.step();
     loss_sum += step.loss, ++loss_count;
+    if (!root) continue;
     if (step.step % args.log_every == 0 || step.step == config.steps) {
       const double now = bar.seconds();
       const double rate = (step.step - window_start_step) / std::max(1e-9, now - window_start_time);
-      log.write_step(step.step, loss_sum / loss_count, step.learning_rate, rate);
+      log->write_step(step.step, loss_sum / loss_count, step.learning_rate, rate);
       bar.update(step.step,
                  fmt::format("loss {:.4f}  {:.1f} steps/s", loss_sum / loss_count, rate));
       loss_sum = 0.0, loss_count = 0;
@@ -146,7 +174,7 @@ void run_train(const TrainArgs& args) {
     if (!valid.empty() && (step.step % args.valid_every == 0 || step.step == config.steps)) {
       ModelPredictor predictor(trainer.model());
       const Evaluation e = evaluate_rollouts(predictor, valid);
-      log.write_validation(step.step, e);
+      log->write_validation(step.step, e);
       fmt::print(stderr, "\nstep {}: validation translation {:.4f} m, rotation {:.2f} deg\n",
                  step.step, e.mean_translation, e.mean_rotation);
     }
@@ -157,11 +185,18 @@ void run_train(const TrainArgs& args) {
       last_checkpoint = now;
     }
   }
-  bar.finish(trainer.steps_done());
   save();
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
-  if (stop_requested) {
+  if (!root) return;
+  bar.finish(trainer.steps_done());
+  if (group.size() > 1) {
+    const double seconds = bar.seconds();
+    const double talking = group.collective->seconds_communicating();
+    fmt::print("{} processes: {:.1f} s in gradient and statistics sums of {:.1f} s ({:.1f} %)\n",
+               group.size(), talking, seconds, 100.0 * talking / std::max(seconds, 1e-9));
+  }
+  if (stopped) {
     fmt::print("stopped at step {}; checkpoint {} (continue with --resume)\n", trainer.steps_done(),
                checkpoint_path.string());
   } else {

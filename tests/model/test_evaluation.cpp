@@ -2,6 +2,7 @@
 // in truth flies without it errs by g·dt²·k(k+1)/2 after k predicted steps.
 #include <gtest/gtest.h>
 
+#include "fignet/error.h"
 #include "fignet/rollout/evaluation.h"
 #include "trajectory_fixtures.h"
 
@@ -36,6 +37,41 @@ TEST(Evaluation, ErrorsMatchAHandComputedCase) {
   EXPECT_EQ(e.trajectories, 2);
   EXPECT_EQ(e.face_edges_per_step, 0.0);
   EXPECT_TRUE(std::isnan(e.penetration_depth_ratio));  // not measured
+}
+
+}  // namespace
+}  // namespace fignet
+
+namespace fignet {
+namespace {
+
+// A set evaluated in two shares (as two processes would), sent through the flat form and merged,
+// summarises to the same figures as the whole set at once.
+TEST(Evaluation, SharesMergeToTheWhole) {
+  const double dt = 0.1;
+  std::vector<Trajectory> set;
+  for (int i = 0; i < 3; ++i) {
+    Trajectory t;
+    t.time_step = dt;
+    t.gravity = Vec3::Zero();
+    t.objects.push_back(testing::ballistic_object(testing::small_cube(), Vec3(0, 0, 5),
+                                                  Vec3(i, 0, 0), Vec3(0, 0, 0.5 * i), 6 + i, dt,
+                                                  Vec3::Zero()));
+    set.push_back(t);
+  }
+  GravityPredictor predictor(Vec3(0, 0, -10), dt, 2);
+  const Evaluation whole = evaluate_rollouts(predictor, set);
+  EvaluationTotals merged = EvaluationTotals::deserialize(
+      evaluate_rollout_totals(predictor, std::span(set).first(1)).serialize());
+  merged += EvaluationTotals::deserialize(
+      evaluate_rollout_totals(predictor, std::span(set).subspan(1)).serialize());
+  const Evaluation parts = summarize(merged);
+  EXPECT_EQ(parts.trajectories, 3);
+  EXPECT_EQ(parts.translation, whole.translation);
+  EXPECT_EQ(parts.rotation, whole.rotation);
+  EXPECT_DOUBLE_EQ(parts.mean_translation, whole.mean_translation);
+  EXPECT_DOUBLE_EQ(parts.final_rotation, whole.final_rotation);
+  EXPECT_THROW(EvaluationTotals::deserialize(std::vector<double>{2.0, 1.0}), ConfigError);
 }
 
 }  // namespace

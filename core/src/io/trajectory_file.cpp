@@ -1,5 +1,7 @@
 #include "fignet/io/trajectory_file.h"
 
+#include <functional>
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -179,7 +181,12 @@ void write_trajectories(const std::filesystem::path& path, std::span<const Traje
   });
 }
 
-std::vector<Trajectory> read_trajectories(const std::filesystem::path& path, DatasetInfo* info) {
+namespace {
+
+// Reads the trajectories of one file whose global index (first_index + position) `keep` accepts;
+// returns how many the file holds.
+long long read_file(const std::filesystem::path& path, DatasetInfo* info, long long first_index,
+                    const std::function<bool(long long)>& keep, std::vector<Trajectory>& result) {
   H5::H5File file = hdf5::open_for_reading(path, kWhat);
   const std::string where = fmt::format("{} '{}'", kWhat, path.string());
   try {
@@ -200,27 +207,45 @@ std::vector<Trajectory> read_trajectories(const std::filesystem::path& path, Dat
     }
     const long long count = hdf5::read_integer(root, "num_trajectories");
     const H5::Group group = file.openGroup("trajectories");
-    std::vector<Trajectory> result;
     for (long long i = 0; i < count; ++i) {
+      if (!keep(first_index + i)) continue;
       const std::string name = fmt::format("{:06d}", i);
       if (!group.nameExists(name)) {
         throw FileError(fmt::format("{}: missing trajectory '{}' of {}", where, name, count));
       }
       result.push_back(read_trajectory(group.openGroup(name), where + " trajectory " + name));
     }
-    return result;
+    return count;
   } catch (const H5::Exception& e) {
     throw FileError(fmt::format("{}: cannot read ({})", where, e.getDetailMsg()));
   }
 }
 
+}  // namespace
+
+std::vector<Trajectory> read_trajectories(const std::filesystem::path& path, DatasetInfo* info) {
+  std::vector<Trajectory> result;
+  read_file(
+      path, info, 0, [](long long) { return true; }, result);
+  return result;
+}
+
 std::vector<Trajectory> read_trajectories(const std::vector<std::filesystem::path>& paths) {
-  std::vector<Trajectory> all;
-  for (const auto& path : paths) {
-    auto part = read_trajectories(path);
-    std::move(part.begin(), part.end(), std::back_inserter(all));
+  return read_trajectories(paths, TrajectoryShare{});
+}
+
+std::vector<Trajectory> read_trajectories(const std::vector<std::filesystem::path>& paths,
+                                          const TrajectoryShare& share) {
+  if (share.count < 1 || share.index < 0 || share.index >= share.count) {
+    throw ConfigError(fmt::format("trajectory share {} of {}", share.index, share.count));
   }
-  return all;
+  std::vector<Trajectory> result;
+  long long first = 0;
+  for (const auto& path : paths) {
+    first += read_file(
+        path, nullptr, first, [&](long long i) { return i % share.count == share.index; }, result);
+  }
+  return result;
 }
 
 }  // namespace fignet

@@ -3,29 +3,40 @@
 #include <chrono>
 #include <cmath>
 
+#include "fignet/error.h"
 #include "fignet/rollout/rollout.h"
 
 namespace fignet {
 
-Evaluation evaluate_rollouts(AccelerationPredictor& predictor, std::span<const Trajectory> truths,
-                             const EvaluationOptions& options) {
-  Evaluation result;
-  result.trajectories = static_cast<int>(truths.size());
-  if (truths.empty()) return result;
-  double seconds = 0.0;
-  PenetrationTotals penetration;
-  long long steps = 0, edges = 0;
-  std::vector<int> frame_counts;
+EvaluationTotals evaluate_rollout_totals(AccelerationPredictor& predictor,
+                                         std::span<const Trajectory> truths,
+                                         const EvaluationOptions& options) {
+  EvaluationTotals totals;
   std::vector<int> face_edges;
   for (const Trajectory& truth : truths) {
     const auto start = std::chrono::steady_clock::now();
     const Trajectory predicted = rollout(predictor, truth, options.frames, &face_edges);
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    steps += static_cast<long long>(face_edges.size());
-    for (int e : face_edges) edges += e;
+    totals.seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    totals.steps += static_cast<long long>(face_edges.size());
+    for (int e : face_edges) totals.face_edges += e;
     const int first = predictor.history() + 1;
-    RolloutErrors errors = rollout_errors(predicted, truth, first);
-    // Per-frame means over the trajectories long enough to have that frame.
+    totals.per_trajectory.push_back(rollout_errors(predicted, truth, first));
+    if (options.penetration) totals.penetration += penetration_totals(predicted, truth, first);
+    if (options.on_trajectory) {
+      options.on_trajectory(static_cast<int>(totals.per_trajectory.size()));
+    }
+  }
+  return totals;
+}
+
+Evaluation summarize(const EvaluationTotals& totals, const EvaluationOptions& options) {
+  Evaluation result;
+  result.trajectories = static_cast<int>(totals.per_trajectory.size());
+  if (result.trajectories == 0) return result;
+  // Per-frame means over the trajectories long enough to have that frame.
+  std::vector<int> frame_counts;
+  for (const RolloutErrors& errors : totals.per_trajectory) {
     const size_t frames = errors.translation.size();
     if (result.translation.size() < frames) {
       result.translation.resize(frames, 0.0);
@@ -41,12 +52,8 @@ Evaluation evaluate_rollouts(AccelerationPredictor& predictor, std::span<const T
     result.final_translation += errors.final_translation;
     result.mean_rotation += errors.mean_rotation;
     result.final_rotation += errors.final_rotation;
-    if (options.penetration) penetration += penetration_totals(predicted, truth, first);
-    result.per_trajectory.push_back(std::move(errors));
-    if (options.on_trajectory)
-      options.on_trajectory(static_cast<int>(result.per_trajectory.size()));
   }
-  const double n = static_cast<double>(truths.size());
+  const double n = result.trajectories;
   for (size_t f = 0; f < result.translation.size(); ++f) {
     result.translation[f] /= frame_counts[f];
     result.rotation[f] /= frame_counts[f];
@@ -55,13 +62,77 @@ Evaluation evaluate_rollouts(AccelerationPredictor& predictor, std::span<const T
   result.final_translation /= n;
   result.mean_rotation /= n;
   result.final_rotation /= n;
-  const PenetrationRatio ratio =
-      options.penetration ? penetration.ratio() : PenetrationRatio{std::nan(""), std::nan("")};
+  const PenetrationRatio ratio = options.penetration ? totals.penetration.ratio()
+                                                     : PenetrationRatio{std::nan(""), std::nan("")};
   result.penetration_depth_ratio = ratio.depth;
   result.penetration_count_ratio = ratio.count;
-  result.face_edges_per_step = steps > 0 ? static_cast<double>(edges) / steps : 0.0;
-  result.milliseconds_per_step = steps > 0 ? 1e3 * seconds / steps : 0.0;
+  const double steps = static_cast<double>(totals.steps);
+  result.face_edges_per_step = steps > 0 ? static_cast<double>(totals.face_edges) / steps : 0.0;
+  result.milliseconds_per_step = steps > 0 ? 1e3 * totals.seconds / steps : 0.0;
+  result.per_trajectory = totals.per_trajectory;
   return result;
+}
+
+Evaluation evaluate_rollouts(AccelerationPredictor& predictor, std::span<const Trajectory> truths,
+                             const EvaluationOptions& options) {
+  return summarize(evaluate_rollout_totals(predictor, truths, options), options);
+}
+
+EvaluationTotals& EvaluationTotals::operator+=(const EvaluationTotals& other) {
+  per_trajectory.insert(per_trajectory.end(), other.per_trajectory.begin(),
+                        other.per_trajectory.end());
+  penetration += other.penetration;
+  steps += other.steps;
+  face_edges += other.face_edges;
+  seconds += other.seconds;
+  return *this;
+}
+
+// [trajectories, steps, face edges, seconds, 4 penetration totals, then per trajectory: frames,
+// translation…, rotation…, mean and final translation, mean and final rotation].
+std::vector<double> EvaluationTotals::serialize() const {
+  std::vector<double> out = {static_cast<double>(per_trajectory.size()),
+                             static_cast<double>(steps),
+                             static_cast<double>(face_edges),
+                             seconds,
+                             penetration.predicted_depth,
+                             penetration.truth_depth,
+                             penetration.predicted_count,
+                             penetration.truth_count};
+  for (const RolloutErrors& e : per_trajectory) {
+    out.push_back(static_cast<double>(e.translation.size()));
+    out.insert(out.end(), e.translation.begin(), e.translation.end());
+    out.insert(out.end(), e.rotation.begin(), e.rotation.end());
+    out.insert(out.end(),
+               {e.mean_translation, e.final_translation, e.mean_rotation, e.final_rotation});
+  }
+  return out;
+}
+
+EvaluationTotals EvaluationTotals::deserialize(std::span<const double> values) {
+  size_t at = 0;
+  const auto next = [&]() {
+    if (at >= values.size()) throw ConfigError("evaluation totals: truncated");
+    return values[at++];
+  };
+  EvaluationTotals totals;
+  const auto count = static_cast<size_t>(next());
+  totals.steps = static_cast<long long>(next());
+  totals.face_edges = static_cast<long long>(next());
+  totals.seconds = next();
+  totals.penetration = {next(), next(), next(), next()};
+  for (size_t t = 0; t < count; ++t) {
+    RolloutErrors e;
+    const auto frames = static_cast<size_t>(next());
+    for (size_t f = 0; f < frames; ++f) e.translation.push_back(next());
+    for (size_t f = 0; f < frames; ++f) e.rotation.push_back(next());
+    e.mean_translation = next();
+    e.final_translation = next();
+    e.mean_rotation = next();
+    e.final_rotation = next();
+    totals.per_trajectory.push_back(std::move(e));
+  }
+  return totals;
 }
 
 }  // namespace fignet

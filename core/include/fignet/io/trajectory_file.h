@@ -32,4 +32,12 @@ std::vector<Trajectory> read_trajectories(const std::filesystem::path& path,
 // Reads several files (shards) in order, concatenated.
 std::vector<Trajectory> read_trajectories(const std::vector<std::filesystem::path>& paths);
 
+// One process's share of several files: of the trajectories in order, every `count`-th from the
+// `index`-th; the others are skipped unread (data-parallel training).
+struct TrajectoryShare {
+  int index = 0, count = 1;
+};
+std::vector<Trajectory> read_trajectories(const std::vector<std::filesystem::path>& paths,
+                                          const TrajectoryShare& share);
+
 }  // namespace fignet

@@ -35,4 +35,21 @@ struct Evaluation {
 Evaluation evaluate_rollouts(AccelerationPredictor& predictor, std::span<const Trajectory> truths,
                              const EvaluationOptions& options = {});
 
+// The same in two halves, for evaluations split across processes: each rolls out its share into
+// totals, the totals are concatenated (in trajectory order) and summarised once.
+struct EvaluationTotals {
+  std::vector<RolloutErrors> per_trajectory;
+  PenetrationTotals penetration;
+  long long steps = 0, face_edges = 0;
+  double seconds = 0.0;
+  EvaluationTotals& operator+=(const EvaluationTotals& other);
+  // Flat form for sending between processes, and back.
+  std::vector<double> serialize() const;
+  static EvaluationTotals deserialize(std::span<const double> values);
+};
+EvaluationTotals evaluate_rollout_totals(AccelerationPredictor& predictor,
+                                         std::span<const Trajectory> truths,
+                                         const EvaluationOptions& options = {});
+Evaluation summarize(const EvaluationTotals& totals, const EvaluationOptions& options = {});
+
 }  // namespace fignet
