@@ -13,6 +13,7 @@
 #include "fignet/io/model_file.h"
 #include "fignet/io/trajectory_file.h"
 #include "fignet/rollout/evaluation.h"
+#include "process_group.h"
 #include "progress.h"
 #include "text_file.h"
 
@@ -38,15 +39,17 @@ std::string kind_of(const ModelConfig& config) {
   return config.graph.collisions == CollisionEdges::kFaceFace ? "FIGNet" : "FIGNet-NoFaceCollision";
 }
 
-// Every trajectory of the files, up to `max` (all when < 0), checked to share one time step.
+// Every trajectory of the files, up to `max` (all when < 0), checked to share one time step;
+// under mpirun, this process's share of them.
 std::vector<Trajectory> read_test_split(const EvalArgs& args) {
-  std::vector<Trajectory> all;
-  for (const fs::path& file : args.data) {
-    for (Trajectory& t : read_trajectories(file)) all.push_back(std::move(t));
-  }
+  std::vector<Trajectory> all = read_trajectories(args.data);
   if (all.empty()) throw ConfigError("--data: the files hold no trajectory");
   if (args.max_trajectories >= 0 && static_cast<int>(all.size()) > args.max_trajectories) {
     all.resize(static_cast<size_t>(args.max_trajectories));
+  }
+  if (static_cast<int>(all.size()) < process_group().size()) {
+    throw ConfigError(fmt::format("--data: {} trajectories for {} processes", all.size(),
+                                  process_group().size()));
   }
   for (const Trajectory& t : all) {
     if (std::abs(t.time_step - all[0].time_step) > 1e-9) {
@@ -54,19 +57,42 @@ std::vector<Trajectory> read_test_split(const EvalArgs& args) {
                                     all[0].time_step, t.time_step));
     }
   }
-  return all;
+  return process_group().share_of(std::move(all));
 }
 
+// This process's rollouts; on process 0, every process's, in the files' trajectory order.
 Row evaluate(const std::string& name, const std::string& kind, AccelerationPredictor& predictor,
              const std::vector<Trajectory>& test, const EvalArgs& args) {
+  const ProcessGroup& group = process_group();
   ProgressBar progress(fmt::format("eval {}", name), static_cast<long long>(test.size()));
   EvaluationOptions options;
   options.frames = args.frames;
   options.penetration = args.penetration;
-  options.on_trajectory = [&](int done) { progress.update(done); };
-  Row row{name, kind, evaluate_rollouts(predictor, test, options)};
-  progress.finish(static_cast<long long>(test.size()));
-  return row;
+  if (group.is_root()) options.on_trajectory = [&](int done) { progress.update(done); };
+  const EvaluationTotals mine = evaluate_rollout_totals(predictor, test, options);
+  if (group.is_root()) progress.finish(static_cast<long long>(test.size()));
+  const std::vector<double> gathered = group.collective->gather(mine.serialize());
+  // Process r holds trajectories r, r + N, …: interleave them back.
+  std::vector<EvaluationTotals> parts;
+  for (size_t at = 0; at < gathered.size();) {
+    size_t used = 0;
+    parts.push_back(EvaluationTotals::deserialize(std::span(gathered).subspan(at), &used));
+    at += used;
+  }
+  EvaluationTotals all;
+  for (const EvaluationTotals& part : parts) {
+    all.penetration += part.penetration;
+    all.steps += part.steps;
+    all.face_edges += part.face_edges;
+    all.seconds += part.seconds;
+  }
+  for (size_t i = 0;; ++i) {
+    const EvaluationTotals& part = parts.empty() ? mine : parts[i % parts.size()];
+    const size_t k = i / std::max<size_t>(parts.size(), 1);
+    if (k >= part.per_trajectory.size()) break;
+    all.per_trajectory.push_back(part.per_trajectory[k]);
+  }
+  return Row{name, kind, summarize(all, options)};
 }
 
 void print_table(const std::vector<Row>& rows) {
@@ -116,6 +142,7 @@ nlohmann::json to_json(const Row& row) {
 
 void run_eval(const EvalArgs& args) {
   const std::vector<Trajectory> test = read_test_split(args);
+  const bool root = process_group().is_root();
   std::vector<Row> rows;
   int history = 2;
   for (const fs::path& file : args.models) {
@@ -127,22 +154,24 @@ void run_eval(const EvalArgs& args) {
     }
     history = config.graph.history;
     ModelPredictor predictor(model, args.threads);
-    rows.push_back(evaluate(file.string(), kind_of(config), predictor, test, args));
+    rows.push_back(evaluate(file.filename().string(), kind_of(config), predictor, test, args));
   }
   if (args.baseline) {
     // Constant velocity under gravity from the same given frames: what no contact model gives.
     GravityPredictor ballistic(test[0].gravity, test[0].time_step, history);
     rows.push_back(evaluate("ballistic", "constant velocity + gravity", ballistic, test, args));
   }
+  if (!root) return;
+  const int trajectories = rows.front().result.trajectories;
   std::vector<std::string> files;
   for (const fs::path& file : args.data) files.push_back(file.string());
-  fmt::print("{} trajectories, {} frames each ({} given), from {}\n", test.size(),
+  fmt::print("{} trajectories, {} frames each ({} given), from {}\n", trajectories,
              args.frames > 0 ? args.frames : test[0].num_frames(), history + 1,
              fmt::join(files, ", "));
   print_table(rows);
   if (!args.json.empty()) {
     nlohmann::json out = {{"data", nlohmann::json::array()},
-                          {"trajectories", test.size()},
+                          {"trajectories", trajectories},
                           {"given_frames", history + 1},
                           {"frame_step_s", test[0].time_step},
                           {"runs", nlohmann::json::array()}};

@@ -65,7 +65,7 @@ void MpiCollective::sum(std::span<double> values) {
   seconds_ += seconds_since(start);
 }
 
-std::vector<double> MpiCollective::gather(const std::vector<double>& values) const {
+std::vector<double> MpiCollective::gather(const std::vector<double>& values) {
   const int count = static_cast<int>(values.size());
   std::vector<int> counts(static_cast<size_t>(size_)), offsets(static_cast<size_t>(size_));
   MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);

@@ -109,7 +109,7 @@ std::vector<double> EvaluationTotals::serialize() const {
   return out;
 }
 
-EvaluationTotals EvaluationTotals::deserialize(std::span<const double> values) {
+EvaluationTotals EvaluationTotals::deserialize(std::span<const double> values, size_t* consumed) {
   size_t at = 0;
   const auto next = [&]() {
     if (at >= values.size()) throw ConfigError("evaluation totals: truncated");
@@ -132,6 +132,7 @@ EvaluationTotals EvaluationTotals::deserialize(std::span<const double> values) {
     e.final_rotation = next();
     totals.per_trajectory.push_back(std::move(e));
   }
+  if (consumed) *consumed = at;
   return totals;
 }
 

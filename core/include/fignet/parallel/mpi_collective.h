@@ -32,8 +32,7 @@ class MpiCollective : public Collective {
   void sum(std::span<float> values) override;
   void sum(std::span<double> values) override;
   double seconds_communicating() const override { return seconds_; }
-  // Every process's `values` concatenated on process 0 in rank order (empty elsewhere).
-  std::vector<double> gather(const std::vector<double>& values) const;
+  std::vector<double> gather(const std::vector<double>& values) override;
 
  private:
   int rank_ = 0, size_ = 1;

@@ -45,7 +45,9 @@ struct EvaluationTotals {
   EvaluationTotals& operator+=(const EvaluationTotals& other);
   // Flat form for sending between processes, and back.
   std::vector<double> serialize() const;
-  static EvaluationTotals deserialize(std::span<const double> values);
+  // Reads one serialized totals from the front of `values`; `consumed` (if given) tells how many
+  // values it took, so concatenated ones can be read in turn.
+  static EvaluationTotals deserialize(std::span<const double> values, size_t* consumed = nullptr);
 };
 EvaluationTotals evaluate_rollout_totals(AccelerationPredictor& predictor,
                                          std::span<const Trajectory> truths,

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <span>
+#include <vector>
 
 namespace fignet {
 
@@ -14,6 +15,8 @@ class Collective {
   // In-place element-wise sums over every process (each call one collective operation).
   virtual void sum(std::span<float> values) { (void)values; }
   virtual void sum(std::span<double> values) { (void)values; }
+  // Every process's `values` concatenated on process 0 in process order (empty elsewhere).
+  virtual std::vector<double> gather(const std::vector<double>& values) { return values; }
   // Seconds spent inside the sums so far (communication and waiting for other processes).
   virtual double seconds_communicating() const { return 0.0; }
 };
