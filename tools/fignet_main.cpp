@@ -71,6 +71,7 @@ int main(int argc, char** argv) {
   fignet::cli::add_train_command(app);
   fignet::cli::add_eval_command(app);
   fignet::cli::add_compare_command(app);
+  fignet::cli::add_stress_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,54 @@
+// The stress suite: scenes at the extremes (long rests, stacks, sizes and densities far from
+// training, impacts faster than the collision radius per step, far from the origin, long
+// rollouts, odd meshes), each run by native Bullet at 240 Hz and by a FIGNet world, with what goes
+// wrong measured the same way for both.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fignet/bullet/bullet_simulation.h"
+#include "fignet/model/model.h"
+
+namespace fignet::bullet {
+
+struct StressCase {
+  std::string name, group;  // e.g. "impact 50 m/s", "speed"
+  SceneSpec scene;
+  bool at_rest = false;     // started at rest: drift and late speed are failures
+  bool compare = true;      // error against Bullet at 240 Hz is meaningful (not chaotic)
+  Vec3 shift = Vec3::Zero();  // a "far from the origin" case: metres it was moved by
+};
+
+// Every case, each `frames` long where the issue fixes no length (0: the cases' own lengths).
+// `scale_frames` < 1 shortens the long cases for quick runs and tests.
+std::vector<StressCase> stress_cases(double scale_frames = 1.0);
+
+struct StressRun {
+  std::string simulator;
+  bool finite = true;             // no NaN or inf in any pose
+  double lowest = 0.0;            // lowest vertex relative to the floor over the run, metres
+  double drift = 0.0;             // at_rest cases: largest centre displacement at the end, metres
+  double drift_degrees = 0.0;     // … and rotation
+  double late_speed = 0.0;        // largest body speed over the last half of the run, m/s
+  double error = 0.0;             // mean translation error against Bullet 240 Hz, metres
+  double milliseconds_per_frame = 0.0;
+  Trajectory trajectory;
+};
+
+struct Simulator {
+  std::string name;
+  SolverSettings settings;
+  WorldFactory make_world;  // none: native Bullet
+};
+
+// Native Bullet at 240 Hz and, per model, a FIGNet world stepping once per frame.
+std::vector<Simulator> stress_simulators(
+    const std::vector<std::pair<std::string, std::shared_ptr<const Model>>>& models);
+
+// Runs one case on each simulator (the first is the reference for `error`).
+std::vector<StressRun> run_stress_case(const StressCase& c, const std::vector<Simulator>& sims);
+
+}  // namespace fignet::bullet

@@ -1,0 +1,230 @@
+#include "fignet/bullet/stress.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "fignet/bullet/fignet_dynamics_world.h"
+#include "fignet/geometry/mass_properties.h"
+#include "fignet/geometry/shapes.h"
+#include "fignet/graph/scene.h"
+#include "fignet/rollout/metrics.h"
+
+namespace fignet::bullet {
+
+namespace {
+
+constexpr double kDensity = 1000.0;
+
+SceneSpec empty_scene(int frames) {
+  SceneSpec spec;
+  spec.floor = Floor{};
+  spec.floor->properties = {0.0, 0.5, 0.3};
+  spec.frames = frames;
+  return spec;
+}
+
+BodySpec box(const Vec3& half, const Vec3& at, double density = kDensity) {
+  BodySpec body = make_body(make_box(half), density, 0.5, 0.3);
+  body.pose.position = at;
+  return body;
+}
+
+// A body of any mesh, even open or flat, with the mass and inertia of its bounding box: the odd
+// meshes of the mesh cases have no volume of their own.
+BodySpec odd_body(const TriangleMesh& mesh, const Vec3& at) {
+  const Vec3 lo = mesh.vertices().colwise().minCoeff().transpose();
+  const Vec3 hi = mesh.vertices().colwise().maxCoeff().transpose();
+  const Vec3 size = (hi - lo).cwiseMax(Vec3::Constant(0.01));
+  BodySpec body;
+  body.mesh = std::make_shared<const TriangleMesh>(
+      mesh.name(), mesh.vertices().rowwise() - (0.5 * (lo + hi)).transpose(), mesh.faces());
+  const double mass = kDensity * size.prod();
+  body.properties = {mass, 0.5, 0.3};
+  body.inertia = mass / 12.0 *
+                 Vec3(size.y() * size.y() + size.z() * size.z(),
+                      size.x() * size.x() + size.z() * size.z(),
+                      size.x() * size.x() + size.y() * size.y());
+  body.pose.position = at;
+  return body;
+}
+
+// Bodies dropped in a column and left to settle by native Bullet, returned at rest.
+SceneSpec settled_pile(int count, int frames) {
+  SceneSpec drop = empty_scene(240);
+  const auto& names = movi_shape_names();
+  for (int i = 0; i < count; ++i) {
+    BodySpec body = make_body(make_movi_shape(names[static_cast<size_t>(i % 3)]), kDensity, 0.5,
+                              0.3);
+    const int per_layer = 4;
+    const double x = (i % per_layer % 2) * 1.3 - 0.65, y = (i % per_layer / 2) * 1.3 - 0.65;
+    body.pose.position = Vec3(x + 0.05 * (i % 5), y, 1.0 + 1.2 * (i / per_layer));
+    drop.bodies.push_back(body);
+  }
+  BulletSimulation settle(drop);
+  for (int f = 0; f < 240; ++f) settle.step_frame();
+  SceneSpec rest = drop;
+  rest.frames = frames;
+  for (size_t i = 0; i < rest.bodies.size(); ++i) {
+    rest.bodies[i].pose = settle.pose(static_cast<int>(i));
+    rest.bodies[i].linear_velocity = rest.bodies[i].angular_velocity = Vec3::Zero();
+  }
+  return rest;
+}
+
+StressCase make_case(std::string name, std::string group, SceneSpec scene, bool at_rest,
+                     bool compare = true) {
+  return {std::move(name), std::move(group), std::move(scene), at_rest, compare, Vec3::Zero()};
+}
+
+}  // namespace
+
+std::vector<StressCase> stress_cases(double scale_frames) {
+  const auto frames = [&](int n) { return std::max(8, static_cast<int>(n * scale_frames)); };
+  std::vector<StressCase> cases;
+  // Rest: drift of one body and of a settled pile over 2000 steps.
+  SceneSpec one = empty_scene(frames(2000));
+  one.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 0.5)));
+  cases.push_back(make_case("one cube at rest", "rest", one, true));
+  cases.push_back(make_case("10-object pile at rest", "rest", settled_pile(10, frames(2000)), true,
+                            false));
+  // Stacks of 2–5 cubes left standing.
+  for (int n = 2; n <= 5; ++n) {
+    SceneSpec stack = empty_scene(frames(480));
+    for (int k = 0; k < n; ++k) stack.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 0.5 + k)));
+    cases.push_back(make_case(fmt::format("stack of {} cubes", n), "stacks", stack, true));
+  }
+  // Sizes far outside training (0.7–1.4 m objects), and a 100:1 density ratio in contact.
+  for (double half : {0.025, 2.5}) {
+    SceneSpec drop = empty_scene(frames(240));
+    drop.bodies.push_back(box(Vec3::Constant(half), Vec3(0, 0, 3 * half)));
+    cases.push_back(
+        make_case(fmt::format("{} m cube dropped", 2 * half), "sizes", drop, false));
+  }
+  for (bool heavy_on_top : {false, true}) {
+    SceneSpec pair = empty_scene(frames(480));
+    pair.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 0.5), heavy_on_top ? 50 : 5000));
+    pair.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 1.5), heavy_on_top ? 5000 : 50));
+    cases.push_back(make_case(heavy_on_top ? "100:1, heavy on light" : "100:1, light on heavy",
+                              "densities", pair, true));
+  }
+  // Impacts faster than the collision radius per step (0.1 m at 48 Hz is 4.8 m/s): on the floor
+  // and on another body.
+  for (double speed : {10.0, 20.0, 50.0}) {
+    SceneSpec floor_hit = empty_scene(frames(96));
+    floor_hit.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 3)));
+    floor_hit.bodies.back().linear_velocity = Vec3(0, 0, -speed);
+    cases.push_back(make_case(fmt::format("{:.0f} m/s onto the floor", speed), "speed", floor_hit,
+                              false));
+    SceneSpec body_hit = empty_scene(frames(96));
+    body_hit.bodies.push_back(box(Vec3(1.5, 1.5, 0.5), Vec3(0, 0, 0.5), 10 * kDensity));
+    body_hit.bodies.push_back(box(Vec3::Constant(0.3), Vec3(0, 0, 4)));
+    body_hit.bodies.back().linear_velocity = Vec3(0, 0, -speed);
+    cases.push_back(make_case(fmt::format("{:.0f} m/s onto a slab", speed), "speed", body_hit,
+                              false));
+  }
+  // Far from the origin: a tossed pair 1 km away in x and y.
+  for (double offset : {0.0, 1000.0}) {
+    SceneSpec toss = empty_scene(frames(96));
+    toss.bodies.push_back(box(Vec3::Constant(0.5), Vec3(offset, offset, 0.5)));
+    toss.bodies.push_back(box(Vec3::Constant(0.4), Vec3(offset + 0.2, offset, 3)));
+    toss.bodies.back().linear_velocity = Vec3(0.5, 0, -2);
+    StressCase c = make_case(offset == 0 ? "tossed pair at the origin" : "tossed pair 1 km away",
+                             "far", toss, false);
+    c.shift = Vec3(offset, offset, 0);
+    cases.push_back(c);
+  }
+  // Long rollouts: 10 objects for 5000 steps, a pile of 100.
+  cases.push_back(make_case("10-object pile, 5000 steps", "long", settled_pile(10, frames(5000)),
+                            true, false));
+  cases.push_back(make_case("100-object pile", "long", settled_pile(100, frames(96)), true, false));
+  // Odd meshes dropped on the floor: a sliver, one triangle, an open box, 20,000 vertices,
+  // coincident vertices.
+  const auto mesh_case = [&](const TriangleMesh& mesh, const std::string& name) {
+    SceneSpec drop = empty_scene(frames(96));
+    drop.bodies.push_back(odd_body(mesh, Vec3(0, 0, 1)));
+    cases.push_back(make_case(name, "meshes", drop, false));
+  };
+  mesh_case(make_box(Vec3(0.5, 0.5, 0.002)), "sliver (1 m x 1 m x 4 mm)");
+  Points corners(3, 3);
+  corners << 0, 0, 0, 1, 0, 0, 0, 1, 0;
+  Triangles one_face(1, 3);
+  one_face << 0, 1, 2;
+  mesh_case(TriangleMesh("triangle", corners, one_face), "a single triangle");
+  const TriangleMesh cube = make_box(Vec3::Constant(0.5), 1);
+  mesh_case(TriangleMesh("open box", cube.vertices(), cube.faces().topRows(10)),
+            "open box (two faces missing)");
+  mesh_case(make_sphere(0.5, 140, 143), "sphere of 20,000 vertices");
+  Points doubled(cube.num_vertices() * 2, 3);
+  doubled << cube.vertices(), cube.vertices();
+  Triangles mixed = cube.faces();
+  for (Eigen::Index f = 0; f < mixed.rows(); f += 2) mixed.row(f).array() += cube.num_vertices();
+  mesh_case(TriangleMesh("coincident", doubled, mixed), "coincident vertices (each twice)");
+  return cases;
+}
+
+std::vector<Simulator> stress_simulators(
+    const std::vector<std::pair<std::string, std::shared_ptr<const Model>>>& models) {
+  std::vector<Simulator> sims;
+  sims.push_back({"Bullet 240 Hz", {}, {}});
+  for (const auto& [name, model] : models) {
+    SolverSettings one_step;
+    one_step.steps_per_frame = 1;
+    std::shared_ptr<const Model> shared = model;
+    sims.push_back({fmt::format("FIGNet {}", name), one_step,
+                    [shared](btDispatcher* d, btBroadphaseInterface* b, btConstraintSolver* s,
+                             btCollisionConfiguration* c) {
+                      return std::make_unique<FIGNetDynamicsWorld>(d, b, s, c, shared);
+                    }});
+  }
+  return sims;
+}
+
+std::vector<StressRun> run_stress_case(const StressCase& c, const std::vector<Simulator>& sims) {
+  std::vector<StressRun> runs;
+  for (const Simulator& sim : sims) {
+    StressRun run;
+    run.simulator = sim.name;
+    const auto start = std::chrono::steady_clock::now();
+    run.trajectory = BulletSimulation(c.scene, sim.settings, sim.make_world).record();
+    run.milliseconds_per_frame =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count() /
+        std::max(1, c.scene.frames - 1);
+    const Trajectory& t = run.trajectory;
+    const double floor = c.scene.floor ? c.scene.floor->height : 0.0;
+    run.lowest = std::numeric_limits<double>::infinity();
+    for (size_t o = 0; o < t.objects.size(); ++o) {
+      const TrajectoryObject& object = t.objects[o];
+      for (int f = 0; f < t.num_frames(); ++f) {
+        const Pose& pose = object.poses[static_cast<size_t>(f)];
+        if (!pose.position.allFinite() || !pose.orientation.coeffs().allFinite()) {
+          run.finite = false;
+          continue;
+        }
+        run.lowest =
+            std::min(run.lowest, posed_vertices(*object.mesh, pose).col(2).minCoeff() - floor);
+        if (f >= t.num_frames() / 2 && f > 0) {
+          run.late_speed = std::max(run.late_speed,
+                                    (pose.position - object.poses[f - 1].position).norm() /
+                                        t.time_step);
+        }
+      }
+      if (c.at_rest && run.finite) {
+        const Pose& first = object.poses.front();
+        const Pose& last = object.poses.back();
+        run.drift = std::max(run.drift, (last.position - first.position).norm());
+        run.drift_degrees = std::max(run.drift_degrees,
+                                     rotation_angle_degrees(first.orientation, last.orientation));
+      }
+    }
+    if (!runs.empty() && run.finite && runs.front().finite) {
+      run.error = rollout_errors(run.trajectory, runs.front().trajectory, 1).mean_translation;
+    }
+    runs.push_back(std::move(run));
+  }
+  return runs;
+}
+
+}  // namespace fignet::bullet
