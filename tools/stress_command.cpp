@@ -36,9 +36,9 @@ double shift_difference(const Trajectory& far, const Trajectory& near, const Vec
   double largest = 0.0;
   for (size_t o = 0; o < far.objects.size(); ++o) {
     for (size_t f = 0; f < far.objects[o].poses.size(); ++f) {
-      largest = std::max(largest, (far.objects[o].poses[f].position - shift -
-                                   near.objects[o].poses[f].position)
-                                      .norm());
+      largest = std::max(
+          largest,
+          (far.objects[o].poses[f].position - shift - near.objects[o].poses[f].position).norm());
     }
   }
   return largest;
@@ -47,8 +47,7 @@ double shift_difference(const Trajectory& far, const Trajectory& near, const Vec
 void run_stress(const StressArgs& args) {
   std::vector<std::pair<std::string, std::shared_ptr<const Model>>> models;
   for (const fs::path& file : args.models) {
-    models.emplace_back(file.filename().string(),
-                        std::make_shared<const Model>(load_model(file)));
+    models.emplace_back(file.filename().string(), std::make_shared<const Model>(load_model(file)));
   }
   const std::vector<bullet::Simulator> sims = bullet::stress_simulators(models);
   std::vector<bullet::StressCase> cases = bullet::stress_cases(args.length);
@@ -69,17 +68,18 @@ void run_stress(const StressArgs& args) {
     progress.update(static_cast<long long>(i + 1), c.name);
     for (size_t s = 0; s < results.back().size(); ++s) {
       const bullet::StressRun& r = results.back()[s];
-      std::string error = s == 0 ? "reference" : c.compare ? fmt::format("{:.3f}", r.error)
-                                                           : fmt::format("({:.3f}, chaotic)", r.error);
+      std::string error = s == 0      ? "reference"
+                          : c.compare ? fmt::format("{:.3f}", r.error)
+                                      : fmt::format("({:.3f}, chaotic)", r.error);
       if (!c.shift.isZero() && i > 0 && cases[i - 1].group == c.group) {
         const double moved = shift_difference(r.trajectory, results[i - 1][s].trajectory, c.shift);
         error += fmt::format("; {:.2g} m from the run at the origin", moved);
       }
-      table += fmt::format(
-          "| {} | {} | {} | {:.3f} | {} | {:.3f} | {} | {:.2f} |\n", c.name, r.simulator,
-          yes_no(r.finite), r.lowest,
-          c.at_rest ? fmt::format("{:.4f} / {:.2f}", r.drift, r.drift_degrees) : "-",
-          r.late_speed, error, r.milliseconds_per_frame);
+      table +=
+          fmt::format("| {} | {} | {} | {:.3f} | {} | {:.3f} | {} | {:.2f} |\n", c.name,
+                      r.simulator, yes_no(r.finite), r.lowest,
+                      c.at_rest ? fmt::format("{:.4f} / {:.2f}", r.drift, r.drift_degrees) : "-",
+                      r.late_speed, error, r.milliseconds_per_frame);
     }
   }
   progress.finish(static_cast<long long>(cases.size()));

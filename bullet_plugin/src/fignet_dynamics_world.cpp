@@ -279,6 +279,65 @@ struct FIGNetDynamicsWorld::Impl {
                      candidates.end());
   }
 
+  // The tunnelling guard. A step longer than the collision radius can carry a body past a surface
+  // that was never within the graph's reach; such a step is swept with the body's convex shape
+  // (or, for compounds, a sphere inside it) and, if it would cross a surface it moves against,
+  // the body stops where it touches, as Bullet's CCD stops a body.
+  void guard_fast_bodies(btCollisionWorld& world) {
+    if (!options.sweep_guard) return;
+    for (size_t i = 0; i < simulated.size(); ++i) {
+      btRigidBody& body = *simulated[i];
+      const Pose& current = states[&body].poses.back();
+      Pose& next_pose = next[i];
+      const Vec3 motion = next_pose.position - current.position;
+      if (motion.norm() <= graph.collision_radius) continue;
+      const btCollisionShape* shape = body.getCollisionShape();
+      std::unique_ptr<btSphereShape> inner;
+      const btConvexShape* swept = nullptr;
+      if (shape->isConvex()) {
+        swept = static_cast<const btConvexShape*>(shape);
+      } else {
+        btVector3 low, high;
+        shape->getAabb(btTransform::getIdentity(), low, high);
+        const btVector3 size = high - low;
+        inner = std::make_unique<btSphereShape>(0.25f * size[size.minAxis()]);
+        swept = inner.get();
+      }
+      Pose from = current, to = current;
+      to.position = next_pose.position;
+      SweepCallback hit(&body, to_bt(from.position), to_bt(to.position));
+      world.convexSweepTest(swept, to_bt(from), to_bt(to), hit);
+      if (!hit.hasHit()) continue;
+      const double fraction = hit.m_closestHitFraction;
+      next_pose.position = current.position + fraction * motion;
+      next_pose.orientation = current.orientation.slerp(fraction, next_pose.orientation);
+      ++stats.guarded_bodies;
+    }
+  }
+
+  // Closest surface the swept body moves against (Bullet's CCD rule: not itself, only objects
+  // with contact response, and only hits whose normal opposes the motion, so sliding along a
+  // surface it rests on is not a hit).
+  struct SweepCallback : btCollisionWorld::ClosestConvexResultCallback {
+    SweepCallback(const btCollisionObject* self, const btVector3& from, const btVector3& to)
+        : ClosestConvexResultCallback(from, to), self_(self) {
+      m_collisionFilterGroup = self->getBroadphaseHandle()->m_collisionFilterGroup;
+      m_collisionFilterMask = self->getBroadphaseHandle()->m_collisionFilterMask;
+    }
+    btScalar addSingleResult(btCollisionWorld::LocalConvexResult& result,
+                             bool normal_in_world) override {
+      if (result.m_hitCollisionObject == self_) return 1;
+      if (!result.m_hitCollisionObject->hasContactResponse()) return 1;
+      const btVector3 normal = normal_in_world
+                                   ? result.m_hitNormalLocal
+                                   : result.m_hitCollisionObject->getWorldTransform().getBasis() *
+                                         result.m_hitNormalLocal;
+      if (normal.dot(m_convexToWorld - m_convexFromWorld) >= 0) return 1;
+      return ClosestConvexResultCallback::addSingleResult(result, normal_in_world);
+    }
+    const btCollisionObject* self_;
+  };
+
   // New poses, velocities and interpolation state of the simulated bodies.
   void write_back() {
     for (size_t i = 0; i < simulated.size(); ++i) {
@@ -485,6 +544,7 @@ void FIGNetDynamicsWorld::internalSingleStepSimulation(btScalar time_step) {
     impl.predictor->predict_with_candidates(impl.scene, impl.candidates,
                                             impl.workspace.accelerations);
     integrate_next_poses(impl.scene, impl.next, impl.workspace);
+    impl.guard_fast_bodies(*this);
   }
   impl.stats.predict_seconds = seconds_since(predict_start);
 

@@ -42,10 +42,10 @@ BodySpec odd_body(const TriangleMesh& mesh, const Vec3& at) {
       mesh.name(), mesh.vertices().rowwise() - (0.5 * (lo + hi)).transpose(), mesh.faces());
   const double mass = kDensity * size.prod();
   body.properties = {mass, 0.5, 0.3};
-  body.inertia = mass / 12.0 *
-                 Vec3(size.y() * size.y() + size.z() * size.z(),
-                      size.x() * size.x() + size.z() * size.z(),
-                      size.x() * size.x() + size.y() * size.y());
+  body.inertia =
+      mass / 12.0 *
+      Vec3(size.y() * size.y() + size.z() * size.z(), size.x() * size.x() + size.z() * size.z(),
+           size.x() * size.x() + size.y() * size.y());
   body.pose.position = at;
   return body;
 }
@@ -55,8 +55,8 @@ SceneSpec settled_pile(int count, int frames) {
   SceneSpec drop = empty_scene(240);
   const auto& names = movi_shape_names();
   for (int i = 0; i < count; ++i) {
-    BodySpec body = make_body(make_movi_shape(names[static_cast<size_t>(i % 3)]), kDensity, 0.5,
-                              0.3);
+    BodySpec body =
+        make_body(make_movi_shape(names[static_cast<size_t>(i % 3)]), kDensity, 0.5, 0.3);
     const int per_layer = 4;
     const double x = (i % per_layer % 2) * 1.3 - 0.65, y = (i % per_layer / 2) * 1.3 - 0.65;
     body.pose.position = Vec3(x + 0.05 * (i % 5), y, 1.0 + 1.2 * (i / per_layer));
@@ -87,20 +87,20 @@ std::vector<StressCase> stress_cases(double scale_frames) {
   SceneSpec one = empty_scene(frames(2000));
   one.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 0.5)));
   cases.push_back(make_case("one cube at rest", "rest", one, true));
-  cases.push_back(make_case("10-object pile at rest", "rest", settled_pile(10, frames(2000)), true,
-                            false));
+  cases.push_back(
+      make_case("10-object pile at rest", "rest", settled_pile(10, frames(2000)), true, false));
   // Stacks of 2–5 cubes left standing.
   for (int n = 2; n <= 5; ++n) {
     SceneSpec stack = empty_scene(frames(480));
-    for (int k = 0; k < n; ++k) stack.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 0.5 + k)));
+    for (int k = 0; k < n; ++k)
+      stack.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 0.5 + k)));
     cases.push_back(make_case(fmt::format("stack of {} cubes", n), "stacks", stack, true));
   }
   // Sizes far outside training (0.7–1.4 m objects), and a 100:1 density ratio in contact.
   for (double half : {0.025, 2.5}) {
     SceneSpec drop = empty_scene(frames(240));
     drop.bodies.push_back(box(Vec3::Constant(half), Vec3(0, 0, 3 * half)));
-    cases.push_back(
-        make_case(fmt::format("{} m cube dropped", 2 * half), "sizes", drop, false));
+    cases.push_back(make_case(fmt::format("{} m cube dropped", 2 * half), "sizes", drop, false));
   }
   for (bool heavy_on_top : {false, true}) {
     SceneSpec pair = empty_scene(frames(480));
@@ -115,14 +115,14 @@ std::vector<StressCase> stress_cases(double scale_frames) {
     SceneSpec floor_hit = empty_scene(frames(96));
     floor_hit.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 3)));
     floor_hit.bodies.back().linear_velocity = Vec3(0, 0, -speed);
-    cases.push_back(make_case(fmt::format("{:.0f} m/s onto the floor", speed), "speed", floor_hit,
-                              false));
+    cases.push_back(
+        make_case(fmt::format("{:.0f} m/s onto the floor", speed), "speed", floor_hit, false));
     SceneSpec body_hit = empty_scene(frames(96));
     body_hit.bodies.push_back(box(Vec3(1.5, 1.5, 0.5), Vec3(0, 0, 0.5), 10 * kDensity));
     body_hit.bodies.push_back(box(Vec3::Constant(0.3), Vec3(0, 0, 4)));
     body_hit.bodies.back().linear_velocity = Vec3(0, 0, -speed);
-    cases.push_back(make_case(fmt::format("{:.0f} m/s onto a slab", speed), "speed", body_hit,
-                              false));
+    cases.push_back(
+        make_case(fmt::format("{:.0f} m/s onto a slab", speed), "speed", body_hit, false));
   }
   // Far from the origin: a tossed pair 1 km away in x and y.
   for (double offset : {0.0, 1000.0}) {
@@ -136,8 +136,8 @@ std::vector<StressCase> stress_cases(double scale_frames) {
     cases.push_back(c);
   }
   // Long rollouts: 10 objects for 5000 steps, a pile of 100.
-  cases.push_back(make_case("10-object pile, 5000 steps", "long", settled_pile(10, frames(5000)),
-                            true, false));
+  cases.push_back(
+      make_case("10-object pile, 5000 steps", "long", settled_pile(10, frames(5000)), true, false));
   cases.push_back(make_case("100-object pile", "long", settled_pile(100, frames(96)), true, false));
   // Odd meshes dropped on the floor: a sliver, one triangle, an open box, 20,000 vertices,
   // coincident vertices.
@@ -206,9 +206,8 @@ std::vector<StressRun> run_stress_case(const StressCase& c, const std::vector<Si
         run.lowest =
             std::min(run.lowest, posed_vertices(*object.mesh, pose).col(2).minCoeff() - floor);
         if (f >= t.num_frames() / 2 && f > 0) {
-          run.late_speed = std::max(run.late_speed,
-                                    (pose.position - object.poses[f - 1].position).norm() /
-                                        t.time_step);
+          run.late_speed = std::max(
+              run.late_speed, (pose.position - object.poses[f - 1].position).norm() / t.time_step);
         }
       }
       if (c.at_rest && run.finite) {

@@ -29,6 +29,10 @@ struct FIGNetWorldOptions {
   // Broadphase boxes grow by d_c plus the distance a body moved in its last step, so a fast body
   // still finds what it is about to hit (false: d_c only, as in training).
   bool grow_search_by_travel = true;
+  // The tunnelling guard: a body whose predicted step is longer than the collision radius has its
+  // motion swept against the world (Bullet's convex cast, as Bullet's own CCD does) and stops at
+  // the first surface it would cross; the model decides everything slower.
+  bool sweep_guard = true;
   // Threads for the network's matrix products (see ModelPredictor; 0: every core). One keeps
   // a step from stalling behind the host program's own threads.
   int threads = 1;
@@ -41,6 +45,7 @@ struct FIGNetStepStats {
   int kinematic_objects = 0;      // static and kinematic bodies in contact range, floor excluded
   int candidate_pairs = 0;        // broadphase pairs handed to the face-pair search
   int face_edges = 0;             // face–face edges of the graph
+  int guarded_bodies = 0;         // bodies stopped by the tunnelling guard
   double prepare_seconds = 0;     // broadphase, islands, meshes and histories
   double predict_seconds = 0;     // graph and network
   double write_back_seconds = 0;  // rigid fits and Bullet state

@@ -17,8 +17,8 @@ namespace fignet::bullet {
 struct StressCase {
   std::string name, group;  // e.g. "impact 50 m/s", "speed"
   SceneSpec scene;
-  bool at_rest = false;     // started at rest: drift and late speed are failures
-  bool compare = true;      // error against Bullet at 240 Hz is meaningful (not chaotic)
+  bool at_rest = false;       // started at rest: drift and late speed are failures
+  bool compare = true;        // error against Bullet at 240 Hz is meaningful (not chaotic)
   Vec3 shift = Vec3::Zero();  // a "far from the origin" case: metres it was moved by
 };
 
@@ -28,12 +28,12 @@ std::vector<StressCase> stress_cases(double scale_frames = 1.0);
 
 struct StressRun {
   std::string simulator;
-  bool finite = true;             // no NaN or inf in any pose
-  double lowest = 0.0;            // lowest vertex relative to the floor over the run, metres
-  double drift = 0.0;             // at_rest cases: largest centre displacement at the end, metres
-  double drift_degrees = 0.0;     // … and rotation
-  double late_speed = 0.0;        // largest body speed over the last half of the run, m/s
-  double error = 0.0;             // mean translation error against Bullet 240 Hz, metres
+  bool finite = true;          // no NaN or inf in any pose
+  double lowest = 0.0;         // lowest vertex relative to the floor over the run, metres
+  double drift = 0.0;          // at_rest cases: largest centre displacement at the end, metres
+  double drift_degrees = 0.0;  // … and rotation
+  double late_speed = 0.0;     // largest body speed over the last half of the run, m/s
+  double error = 0.0;          // mean translation error against Bullet 240 Hz, metres
   double milliseconds_per_frame = 0.0;
   Trajectory trajectory;
 };
