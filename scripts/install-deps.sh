@@ -14,6 +14,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin
   chromium
+  clang libclang-rt-14-dev libomp-14-dev
 )
 # Node.js and npm from Debian unless some other install already provides both (Node.js builds
 # that bundle npm conflict with Debian's npm package).

@@ -1,6 +1,7 @@
 #include "hdf5_util.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <sstream>
@@ -107,10 +108,22 @@ void write_doubles(H5::Group& group, const std::string& path, const double* data
   write_dataset(group, path, data, shape, H5::PredType::NATIVE_DOUBLE, H5::PredType::IEEE_F64LE);
 }
 
-std::vector<hsize_t> shape_of(const H5::DataSet& dataset) {
+std::vector<hsize_t> shape_of(const H5::DataSet& dataset, const std::string& where) {
   const H5::DataSpace space = dataset.getSpace();
   std::vector<hsize_t> shape(space.getSimpleExtentNdims());
   space.getSimpleExtentDims(shape.data());
+  // A corrupt header can declare any size; this library writes every dataset whole, so more
+  // elements than the file stores is a damaged file, not a reason to allocate terabytes.
+  long double elements = 1;
+  for (hsize_t n : shape) elements *= static_cast<long double>(n);
+  const long double needed = elements * dataset.getDataType().getSize();
+  const hsize_t stored = dataset.getStorageSize();
+  if (needed > static_cast<long double>(stored)) {
+    throw FileError(fmt::format(
+        "{}{}dataset '{}' declares [{}] but the file stores {} bytes of "
+        "it: the file is truncated or corrupt",
+        where, where.empty() ? "" : ": ", dataset.getObjName(), fmt::join(shape, ", "), stored));
+  }
   return shape;
 }
 

@@ -27,7 +27,9 @@ void write_floats(H5::Group& group, const std::string& path, const float* data,
                   const std::vector<hsize_t>& shape);
 void write_doubles(H5::Group& group, const std::string& path, const double* data,
                    const std::vector<hsize_t>& shape);
-std::vector<hsize_t> shape_of(const H5::DataSet& dataset);
+// The dataset's dimensions; throws FileError (prefixed by `where`) when they need more bytes than
+// the file stores for it (a corrupt header).
+std::vector<hsize_t> shape_of(const H5::DataSet& dataset, const std::string& where = "");
 void read_floats(const H5::DataSet& dataset, float* out);
 void read_doubles(const H5::DataSet& dataset, double* out);
 

@@ -79,7 +79,7 @@ Rows read_rows(const H5::Group& group, const std::string& name, hsize_t rows, hs
   if (!group.nameExists(name))
     throw FileError(fmt::format("{}: missing dataset '{}'", where, name));
   const H5::DataSet dataset = group.openDataSet(name);
-  const auto shape = hdf5::shape_of(dataset);
+  const auto shape = hdf5::shape_of(dataset, where);
   if (shape.size() != 2 || (rows && shape[0] != rows) || shape[1] != cols) {
     throw FileError(fmt::format("{}: dataset '{}' has shape [{}], expected [{}, {}]", where, name,
                                 fmt::join(shape, ", "), rows ? std::to_string(rows) : "n", cols));
@@ -98,7 +98,7 @@ TrajectoryObject read_object(const H5::Group& group, const std::string& where) {
   if (!group.nameExists("faces"))
     throw FileError(fmt::format("{}: missing dataset 'faces'", where));
   const H5::DataSet faces_set = group.openDataSet("faces");
-  const auto face_shape = hdf5::shape_of(faces_set);
+  const auto face_shape = hdf5::shape_of(faces_set, where);
   if (face_shape.size() != 2 || face_shape[1] != 3) {
     throw FileError(fmt::format("{}: dataset 'faces' is not [n, 3]", where));
   }

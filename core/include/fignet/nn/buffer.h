@@ -33,7 +33,10 @@ class Buffer {
   ConstMatrixView cget() const { return get(); }
 
  private:
-  AlignedFloats data_;
+  // Never empty: a view of zero rows still points at storage, so column blocks of it (which add
+  // an offset to the pointer) are defined behaviour, not arithmetic on null (UBSan,
+  // fuzz_model_file).
+  AlignedFloats data_ = AlignedFloats(1);
   Eigen::Index rows_ = 0, cols_ = 0;
 };
 
