@@ -1,5 +1,7 @@
 #include "fignet/train/training_config.h"
 
+#include <cmath>
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -189,10 +191,15 @@ void TrainingConfig::validate() const {
     throw ConfigError(fmt::format("batch_size = {} (must be in 1..4096)", trainer.batch_size));
   }
   const AdamConfig& adam = trainer.adam;
-  if (!(adam.learning_rate_start > 0) || !(adam.learning_rate_end > 0)) {
-    throw ConfigError("learning rates must be > 0");
+  for (const auto& [name, rate] : {std::pair("learning_rate_start", adam.learning_rate_start),
+                                   std::pair("learning_rate_end", adam.learning_rate_end)}) {
+    if (!(rate > 0) || !std::isfinite(rate)) {
+      throw ConfigError(fmt::format("{} = {} (must be > 0)", name, rate));
+    }
   }
-  if (adam.decay_steps < 1) throw ConfigError("decay_steps must be >= 1");
+  if (adam.decay_steps < 1) {
+    throw ConfigError(fmt::format("decay_steps = {} (must be >= 1)", adam.decay_steps));
+  }
   if (steps < 0) throw ConfigError(fmt::format("steps = {} (must be >= 0)", steps));
 }
 
