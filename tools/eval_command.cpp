@@ -72,7 +72,7 @@ Row evaluate(const std::string& name, const std::string& kind, AccelerationPredi
   const EvaluationTotals mine = evaluate_rollout_totals(predictor, test, options);
   if (group.is_root()) progress.finish(static_cast<long long>(test.size()));
   const std::vector<double> gathered = group.collective->gather(mine.serialize());
-  // Process r holds trajectories r, r + N, …: interleave them back.
+  if (!group.is_root()) return Row{name, kind, summarize(mine, options)};  // not printed
   std::vector<EvaluationTotals> parts;
   for (size_t at = 0; at < gathered.size();) {
     size_t used = 0;
@@ -80,18 +80,16 @@ Row evaluate(const std::string& name, const std::string& kind, AccelerationPredi
     at += used;
   }
   EvaluationTotals all;
-  for (const EvaluationTotals& part : parts) {
-    all.penetration += part.penetration;
-    all.steps += part.steps;
-    all.face_edges += part.face_edges;
-    all.seconds += part.seconds;
+  for (const EvaluationTotals& part : parts) all += part;  // process order
+  // Process r holds trajectories r, r + N, …: put them back in the files' order.
+  std::vector<RolloutErrors> in_file_order(all.per_trajectory.size());
+  size_t next = 0;
+  for (size_t r = 0; r < parts.size(); ++r) {
+    for (size_t k = 0; k < parts[r].per_trajectory.size(); ++k) {
+      in_file_order[r + k * parts.size()] = std::move(all.per_trajectory[next++]);
+    }
   }
-  for (size_t i = 0;; ++i) {
-    const EvaluationTotals& part = parts.empty() ? mine : parts[i % parts.size()];
-    const size_t k = i / std::max<size_t>(parts.size(), 1);
-    if (k >= part.per_trajectory.size()) break;
-    all.per_trajectory.push_back(part.per_trajectory[k]);
-  }
+  all.per_trajectory = std::move(in_file_order);
   return Row{name, kind, summarize(all, options)};
 }
 

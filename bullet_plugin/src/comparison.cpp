@@ -9,6 +9,7 @@
 #include "fignet/bullet/fignet_dynamics_world.h"
 #include "fignet/error.h"
 #include "fignet/geometry/mass_properties.h"
+#include "fignet/rollout/evaluation.h"
 
 namespace fignet::bullet {
 
@@ -96,22 +97,17 @@ WorldFactory world_for(const ComparisonRun& run) {
   };
 }
 
-// Per-frame means over scenes and the summary means, as `fignet eval` reports them.
+// Per-frame means over scenes and the summary means: `fignet eval`'s summary of the same errors.
 void summarise(RunResult& result) {
-  const size_t frames = result.errors.front().translation.size();
-  result.translation.assign(frames, 0.0);
-  result.rotation.assign(frames, 0.0);
-  const double n = static_cast<double>(result.errors.size());
-  for (const RolloutErrors& e : result.errors) {
-    for (size_t f = 0; f < frames && f < e.translation.size(); ++f) {
-      result.translation[f] += e.translation[f] / n;
-      result.rotation[f] += e.rotation[f] / n;
-    }
-    result.mean_translation += e.mean_translation / n;
-    result.final_translation += e.final_translation / n;
-    result.mean_rotation += e.mean_rotation / n;
-    result.final_rotation += e.final_rotation / n;
-  }
+  EvaluationTotals totals;
+  totals.per_trajectory = result.errors;
+  const Evaluation e = summarize(totals);
+  result.translation = e.translation;
+  result.rotation = e.rotation;
+  result.mean_translation = e.mean_translation;
+  result.final_translation = e.final_translation;
+  result.mean_rotation = e.mean_rotation;
+  result.final_rotation = e.final_rotation;
 }
 
 }  // namespace
