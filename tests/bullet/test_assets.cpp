@@ -3,6 +3,7 @@
 #include <fstream>
 #include <set>
 
+#include "../error_text.h"
 #include "../temp_folder.h"
 #include "fignet/bullet/bullet_simulation.h"
 #include "fignet/bullet/dataset_generator.h"
@@ -15,14 +16,7 @@ namespace {
 
 using Assets = testing::TempFolderTest;
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using testing::error_of;
 
 // A horizontal peg (a 10 cm square bar along x, top at z = 2.05) through the hole of a torus
 // (R = 0.7, r = 0.3) whose axis is along x. Hanging, the ring's inner surface rests on the peg:

@@ -5,6 +5,7 @@
 
 #include <fstream>
 
+#include "../error_text.h"
 #include "../temp_folder.h"
 #include "fignet/bullet/rigid_bodies.h"
 #include "fignet/bullet/urdf.h"
@@ -16,21 +17,14 @@
 namespace fignet::bullet {
 namespace {
 
+using testing::error_of;
+
 class Urdf : public testing::TempFolderTest {
  protected:
   std::filesystem::path write_urdf(const std::string& body, const std::string& name = "r.urdf") {
     const std::filesystem::path path = dir_ / name;
     std::ofstream(path) << "<?xml version=\"1.0\"?>\n<robot name=\"r\">\n" << body << "</robot>\n";
     return path;
-  }
-  template <typename F>
-  std::string error_of(F&& f) {
-    try {
-      f();
-    } catch (const Error& e) {
-      return e.what();
-    }
-    return "no error";
   }
 };
 

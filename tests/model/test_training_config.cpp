@@ -1,18 +1,15 @@
 #include <gtest/gtest.h>
 
+#include "../error_text.h"
 #include "fignet/error.h"
 #include "fignet/train/training_config.h"
 
 namespace fignet {
 namespace {
 
+// Only ConfigErrors count here: another error type would be the wrong report.
 std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "no ConfigError";
+  return testing::error_of<ConfigError>(f);
 }
 
 TEST(TrainingConfig, JsonRoundTripKeepsEveryField) {
