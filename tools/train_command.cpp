@@ -12,6 +12,7 @@
 #include <span>
 
 #include "commands.h"
+#include "device_option.h"
 #include "fignet/error.h"
 #include "fignet/io/checkpoint.h"
 #include "fignet/io/model_file.h"
@@ -38,6 +39,7 @@ struct TrainArgs {
   double checkpoint_minutes = 10.0;
   std::int64_t log_every = 100, valid_every = 2000;
   int valid_trajectories = 10, threads = 0;
+  DeviceArgs device;
 };
 
 volatile std::sig_atomic_t stop_requested = 0;
@@ -134,6 +136,10 @@ void run_train(const TrainArgs& args) {
 
   Trainer trainer(config.model, config.trainer, data, initial.get(), group.collective);
   if (args.resume) trainer.restore(state);
+  if (auto backend = make_backend(args.device, trainer.network())) {
+    trainer.set_backend(std::move(backend));
+  }
+  if (root) fmt::print("network passes on: {}\n", trainer.backend().name());
   std::optional<TrainingLog> log;
   if (root) log.emplace(log_path, trainer.steps_done());
 
@@ -152,6 +158,7 @@ void run_train(const TrainArgs& args) {
     return stop > 0.0;
   };
   ProgressBar bar(root ? "train" : "", config.steps, trainer.steps_done());
+  const std::int64_t first_step = trainer.steps_done();
   auto last_checkpoint = std::chrono::steady_clock::now();
   double loss_sum = 0.0;
   int loss_count = 0;
@@ -167,7 +174,8 @@ void run_train(const TrainArgs& args) {
       const double rate = (step.step - window_start_step) / std::max(1e-9, now - window_start_time);
       log->write_step(step.step, loss_sum / loss_count, step.learning_rate, rate);
       bar.update(step.step,
-                 fmt::format("loss {:.4f}  {:.1f} steps/s", loss_sum / loss_count, rate));
+                 fmt::format("loss {:.4f}  {:.1f} steps/s  {:.0f} samples/s", loss_sum / loss_count,
+                             rate, rate * config.trainer.batch_size));
       loss_sum = 0.0, loss_count = 0;
       window_start_step = step.step, window_start_time = now;
     }
@@ -190,6 +198,17 @@ void run_train(const TrainArgs& args) {
   std::signal(SIGTERM, SIG_DFL);
   if (!root) return;
   bar.finish(trainer.steps_done());
+  const TrainerTimes& times = trainer.times();
+  const double steps_run =
+      std::max<double>(1.0, static_cast<double>(trainer.steps_done() - first_step));
+  fmt::print(
+      "per step ({} scenes): {:.1f} ms building graphs, {:.1f} ms input statistics, {:.1f} ms "
+      "network ({}), {:.1f} ms Adam\n",
+      config.trainer.batch_size, 1e3 * times.build / steps_run, 1e3 * times.statistics / steps_run,
+      1e3 * times.network / steps_run, trainer.backend().name(), 1e3 * times.optimizer / steps_run);
+  if (const std::string profile = trainer.backend().profile(); !profile.empty()) {
+    fmt::print("{}: {}\n", trainer.backend().name(), profile);
+  }
   if (group.size() > 1) {
     const double seconds = bar.seconds();
     const double talking = group.collective->seconds_communicating();
@@ -259,6 +278,7 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--threads", args->threads, "OpenMP threads (0: every core)")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
+  add_device_options(*cmd, args->device);
   cmd->callback([args] { run_train(*args); });
 }
 

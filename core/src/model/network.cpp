@@ -4,14 +4,6 @@
 
 namespace fignet {
 
-// Weights of one message-passing step.
-struct Network::Step {
-  std::vector<Mlp> edges;  // per regular kind; input [edge, sender, receiver]
-  Mlp face;                // input [q_j, v_sj, v_rj] for j = 1..3; output 3L
-  Mlp object_node;         // input [v, Σ mesh->object]
-  Mlp mesh_node;           // input [v, Σ per incoming regular kind, Σ face-face]
-};
-
 namespace {
 
 // Latents of one level (after `level` message-passing steps).

@@ -14,9 +14,19 @@ Normalizer::Normalizer(int size, std::int64_t max_accumulations)
 
 void Normalizer::accumulate(const ConstMatrixRef& rows) {
   if (frozen() || rows.rows() == 0) return;
-  const Eigen::MatrixXd values = rows.cast<double>();
-  add(static_cast<double>(rows.rows()), values.colwise().sum().transpose(),
-      values.array().square().colwise().sum().matrix().transpose());
+  // One pass in double, row by row (no copy of the rows: batches have ~10^5 of them).
+  const int n = size();
+  scratch_sum_.setZero(n);
+  scratch_squares_.setZero(n);
+  for (Eigen::Index r = 0; r < rows.rows(); ++r) {
+    const float* row = rows.row(r).data();
+    for (int c = 0; c < n; ++c) {
+      const double value = row[c];
+      scratch_sum_[c] += value;
+      scratch_squares_[c] += value * value;
+    }
+  }
+  add(static_cast<double>(rows.rows()), scratch_sum_, scratch_squares_);
 }
 
 void Normalizer::add(double count, const Eigen::VectorXd& sum, const Eigen::VectorXd& sum_squares) {

@@ -2,13 +2,20 @@
 
 #include <fmt/format.h>
 
+#include <omp.h>
+
 #include <algorithm>
+#include <chrono>
 
 #include "fignet/error.h"
 
 namespace fignet {
 
 namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
 // One process: sums are the values themselves.
 Collective& single_process() {
@@ -33,7 +40,8 @@ Trainer::Trainer(const ModelConfig& config, const TrainerConfig& trainer_config,
       network_(config),
       normalizers_(network_.make_normalizers()),
       collective_(collective ? collective : &single_process()),
-      builder_(config.graph) {
+      backend_(make_cpu_backend(network_)),
+      builders_(1, GraphBuilder(config.graph)) {
   if (trainer_config.batch_size < 1) {
     throw ConfigError(
         fmt::format("trainer: batch_size = {} (must be >= 1)", trainer_config.batch_size));
@@ -76,6 +84,7 @@ std::mt19937_64 Trainer::step_generator(std::int64_t step) const {
 
 void Trainer::prepare_batch(const std::vector<SampleRef>& batch, std::mt19937_64& noise,
                             bool accumulate) {
+  const auto start = std::chrono::steady_clock::now();
   const int h = config_.graph.history;
   scenes_.resize(batch.size());
   scene_targets_.resize(batch.size());
@@ -87,9 +96,50 @@ void Trainer::prepare_batch(const std::vector<SampleRef>& batch, std::mt19937_64
     make_noisy_sample(data_[batch[b].trajectory], batch[b].frame, h, config_.noise_std, noise,
                       scenes_[b], scene_targets_[b]);
   }
-  builder_.build(scenes_, graph_);
+  build_batch_graph();
   gather_targets(graph_, scene_targets_, targets_, in_loss_);
-  if (accumulate) accumulate_statistics();
+  times_.build += seconds_since(start);
+  if (accumulate) {
+    const auto statistics_start = std::chrono::steady_clock::now();
+    accumulate_statistics();
+    times_.statistics += seconds_since(statistics_start);
+  }
+}
+
+void Trainer::build_batch_graph() {
+  // Contiguous runs of scenes per thread; small batches stay on the calling thread.
+  constexpr int kMinScenesPerPart = 4;
+  const int scenes = static_cast<int>(scenes_.size());
+  const int parts = std::clamp(std::min(omp_get_max_threads(), scenes / kMinScenesPerPart), 1, 64);
+  if (parts == 1) {
+    builders_[0].build(scenes_, graph_);
+    return;
+  }
+  while (static_cast<int>(builders_.size()) < parts) builders_.emplace_back(config_.graph);
+  if (static_cast<int>(part_graphs_.size()) < parts) part_graphs_.resize(parts);
+  const std::span<const Scene> all(scenes_);
+  auto part_of = [&](int i) {
+    const int begin = scenes * i / parts, end = scenes * (i + 1) / parts;
+    return all.subspan(begin, end - begin);
+  };
+  // The first part is built straight into the batch graph, the others beside it.
+  std::exception_ptr failure;
+#pragma omp parallel for num_threads(parts) schedule(static, 1)
+  for (int i = 0; i < parts; ++i) {
+    try {
+      builders_[i].build(part_of(i), i == 0 ? graph_ : part_graphs_[i]);
+    } catch (...) {
+#pragma omp critical
+      if (!failure) failure = std::current_exception();
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+  for (int i = 1; i < parts; ++i) append_graph(part_graphs_[i], graph_);
+}
+
+void Trainer::set_backend(std::unique_ptr<NetworkBackend> backend) {
+  if (!backend) throw ConfigError("trainer: set_backend(nullptr)");
+  backend_ = std::move(backend);
 }
 
 void Trainer::accumulate_statistics() {
@@ -126,7 +176,7 @@ void Trainer::accumulate_statistics() {
 
 double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
   const ConstMatrixView output =
-      network_.forward(params_.data(), normalizers_, graph_, workspace_, with_gradient);
+      backend_->forward(params_.data(), normalizers_, graph_, with_gradient);
   normalized_targets_.resize(targets_.rows(), 3);
   normalizers_.target.normalize(targets_, normalized_targets_);
   double local_squares = 0.0;
@@ -152,7 +202,7 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
         d_output_(i, c) = scale * (output(i, c) - normalized_targets_(i, c));
     }
     std::fill(grads_.begin(), grads_.end(), 0.0f);
-    network_.backward(params_.data(), grads_.data(), graph_, d_output_, workspace_);
+    backend_->backward(params_.data(), grads_.data(), graph_, d_output_);
     // Each process's gradient is its part of the global mean's: their sum is the whole.
     if (reduce) collective_->sum(std::span<float>(grads_.data(), grads_.size()));
   }
@@ -172,8 +222,13 @@ TrainStep Trainer::step_on(const std::vector<SampleRef>& samples, std::uint64_t 
   prepare_batch(samples, noise, /*accumulate=*/true);
   TrainStep result;
   result.learning_rate = adam_.learning_rate();
+  auto start = std::chrono::steady_clock::now();
   result.loss = loss_and_gradient(true, true);
+  times_.network += seconds_since(start);
+  start = std::chrono::steady_clock::now();
   adam_.update(params_, grads_);
+  backend_->parameters_changed();
+  times_.optimizer += seconds_since(start);
   result.step = adam_.step();
   return result;
 }

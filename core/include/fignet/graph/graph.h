@@ -81,4 +81,9 @@ struct Graph {
   int num_scenes() const { return static_cast<int>(scene_first_object.size()) - 1; }
 };
 
+// Appends the scenes of `part` to `whole`, offsetting every index: building scenes A then B into
+// one graph equals building A, building B, and appending B's graph (so batches can be built by
+// several threads). Throws ConfigError when their feature widths differ.
+void append_graph(const Graph& part, Graph& whole);
+
 }  // namespace fignet

@@ -73,14 +73,28 @@ class Network {
   void backward(const float* params, float* grads, const Graph& graph,
                 const ConstMatrixRef& d_output, NetworkWorkspace& ws) const;
 
- private:
-  struct EdgeModules;
-  struct Step;
+  // Weights of one message-passing step.
+  struct Step {
+    std::vector<Mlp> edges;  // per regular kind; input [edge, sender, receiver]
+    Mlp face;                // input [q_j, v_sj, v_rj] for j = 1..3; output 3L
+    Mlp object_node;         // input [v, Σ mesh->object]
+    Mlp mesh_node;           // input [v, Σ per incoming regular kind, Σ face-face]
+  };
 
+  // The modules and wiring, for backends that run this same computation elsewhere (CUDA).
+  const FeatureSizes& sizes() const { return sizes_; }
+  bool face_edges() const { return face_edges_; }
+  const Mlp& mesh_node_encoder() const { return encode_mesh_node_; }
+  const Mlp& object_node_encoder() const { return encode_object_node_; }
+  const Mlp& face_encoder() const { return encode_face_; }
+  const Mlp& edge_encoder(int kind) const { return encode_edges_[kind]; }
+  const Step& step(int k) const { return steps_[k]; }
+  const Mlp& decoder() const { return decoder_; }
   const EdgeSet& edges_of(const Graph& graph, int kind) const;
   NodeSet sender_set(int kind) const;
   NodeSet receiver_set(int kind) const;
 
+ private:
   ModelConfig config_;
   FeatureSizes sizes_;
   std::vector<EdgeKind> edge_kinds_;

@@ -50,6 +50,7 @@ class Normalizer {
   double count_ = 0.0;
   Eigen::VectorXd sum_, sum_squares_;
   Eigen::RowVectorXf mean_, std_, inverse_std_;
+  Eigen::VectorXd scratch_sum_, scratch_squares_;  // accumulate()'s, kept to avoid allocating
 };
 
 }  // namespace fignet

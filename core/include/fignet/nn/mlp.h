@@ -19,6 +19,11 @@ struct MlpCache {
   Buffer d_first;               // backward's result: d(first-layer product), rows x hidden
 };
 
+// Where an MLP's tensors start in the flat parameter array (offsets in floats).
+struct MlpTensors {
+  size_t w0 = 0, b0 = 0, w1 = 0, b1 = 0, w2 = 0, b2 = 0, scale = 0, offset = 0;
+};
+
 class Mlp {
  public:
   static constexpr float kLayerNormEpsilon = 1e-5f;
@@ -32,6 +37,10 @@ class Mlp {
   int hidden() const { return hidden_; }
   int output() const { return output_; }
   int num_blocks() const { return static_cast<int>(block_sizes_.size()); }
+  int input() const { return input_; }
+  bool layer_norm() const { return layer_norm_; }
+  // For other backends, which run the same computation on their own copy of the parameters.
+  MlpTensors tensors() const { return {w0_, b0_, w1_, b1_, w2_, b2_, scale_, offset_}; }
 
   // Rows of the first weight that multiply input block k.
   ConstMatrixView first_weight(const float* params, int k) const;

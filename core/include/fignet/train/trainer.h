@@ -15,6 +15,7 @@
 
 #include "fignet/graph/graph_builder.h"
 #include "fignet/model/model.h"
+#include "fignet/model/network_backend.h"
 #include "fignet/nn/adam.h"
 #include "fignet/train/collective.h"
 #include "fignet/train/training_batch.h"
@@ -36,6 +37,13 @@ struct TrainerState {
   std::string rng;  // unused since sampling is counter-based; kept for older checkpoints
 };
 
+// Wall-clock seconds spent in each phase of the steps so far (this process), to tell what bounds
+// training: building graphs on the CPU, input statistics, the network's passes, or Adam.
+struct TrainerTimes {
+  double build = 0.0, statistics = 0.0, network = 0.0, optimizer = 0.0;
+  double total() const { return build + statistics + network + optimizer; }
+};
+
 struct TrainStep {
   std::int64_t step = 0;  // steps done, this one included
   double loss = 0.0;      // mean squared normalised error over the batch's dynamic nodes
@@ -50,6 +58,9 @@ class Trainer {
   Trainer(const ModelConfig& config, const TrainerConfig& trainer_config,
           const std::vector<Trajectory>& data, const Model* initial = nullptr,
           Collective* collective = nullptr);
+  // The backend holds on to network(): a trainer stays where it was made.
+  Trainer(const Trainer&) = delete;
+  Trainer& operator=(const Trainer&) = delete;
 
   // One optimisation step on a random batch (this process's share of it).
   TrainStep step();
@@ -61,6 +72,12 @@ class Trainer {
   // The loss of one batch of this process's data, without updating anything or communicating
   // (noise included, as in training).
   double evaluate_loss(const std::vector<SampleRef>& samples);
+
+  // Runs the network's passes on `backend` (made for network()) from the next step on; the CPU
+  // backend by default. Sampling, noise, statistics and Adam are unchanged.
+  void set_backend(std::unique_ptr<NetworkBackend> backend);
+  const NetworkBackend& backend() const { return *backend_; }
+  const Network& network() const { return network_; }
 
   // An immutable snapshot of the current parameters and statistics.
   std::shared_ptr<const Model> model() const;
@@ -75,6 +92,7 @@ class Trainer {
 
   const std::vector<float>& parameters() const { return params_; }
   const Adam& optimizer() const { return adam_; }
+  const TrainerTimes& times() const { return times_; }
   const Normalizers& normalizers() const { return normalizers_; }
   // This process's share of a global batch of `batch` samples.
   int local_batch_size(int batch) const;
@@ -82,6 +100,8 @@ class Trainer {
  private:
   // Builds the batch graph and targets; accumulates statistics while they are not frozen.
   void prepare_batch(const std::vector<SampleRef>& batch, std::mt19937_64& noise, bool accumulate);
+  // Builds graph_ from scenes_, in parallel parts for large batches.
+  void build_batch_graph();
   // Adds this step's statistics of every input and of the targets, summed over processes.
   void accumulate_statistics();
   // Mean over every process's dynamic nodes; with `reduce`, counts and gradients are summed
@@ -99,16 +119,19 @@ class Trainer {
   Adam adam_;
   Collective* collective_;
   std::vector<SampleRef> samples_, batch_;
-  // Scratch reused every step.
-  GraphBuilder builder_;
+  std::unique_ptr<NetworkBackend> backend_;
+  // Scratch reused every step. Batches are built by up to one builder per OpenMP thread, each
+  // into its own part of the batch, then appended in scene order.
+  std::vector<GraphBuilder> builders_;
+  std::vector<Graph> part_graphs_;
   Graph graph_;
   std::vector<Scene> scenes_;
   std::vector<Points> scene_targets_;
   RowMatrixXf targets_, normalized_targets_, d_output_;
   std::vector<std::uint8_t> in_loss_;
-  NetworkWorkspace workspace_;
   Normalizers batch_statistics_;
   std::vector<double> statistics_buffer_;
+  TrainerTimes times_;
 };
 
 }  // namespace fignet

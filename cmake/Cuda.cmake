@@ -1,0 +1,23 @@
+# Decides FIGNET_CUDA_ENABLED from FIGNET_WITH_CUDA: AUTO builds the backend when a CUDA compiler
+# and cuBLAS are found, ON requires them, OFF skips them.
+set(FIGNET_CUDA_ENABLED OFF)
+if(NOT FIGNET_WITH_CUDA STREQUAL "OFF")
+  include(CheckLanguage)
+  check_language(CUDA)
+  if(CMAKE_CUDA_COMPILER)
+    # Turing to Hopper as machine code (CUDA 13 dropped Volta), and Hopper's PTX for newer GPUs (the driver compiles it).
+    if(NOT DEFINED CMAKE_CUDA_ARCHITECTURES)
+      set(CMAKE_CUDA_ARCHITECTURES 75-real 80-real 86-real 89-real 90)
+    endif()
+    set(CMAKE_CUDA_HOST_COMPILER ${CMAKE_CXX_COMPILER} CACHE FILEPATH "nvcc's host compiler")
+    enable_language(CUDA)
+    find_package(CUDAToolkit)
+    if(TARGET CUDA::cublas)
+      set(FIGNET_CUDA_ENABLED ON)
+    endif()
+  endif()
+  if(FIGNET_WITH_CUDA STREQUAL "ON" AND NOT FIGNET_CUDA_ENABLED)
+    message(FATAL_ERROR "FIGNET_WITH_CUDA=ON but no CUDA compiler with cuBLAS was found")
+  endif()
+endif()
+message(STATUS "fignet: CUDA backend ${FIGNET_CUDA_ENABLED}")
