@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <atomic>
+#include <nlohmann/json.hpp>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -47,7 +49,16 @@ extern "C" void request_stop(int) {
   stop_requested = 1;
 }
 
+// Whether the JSON config file names `key` (false without a file).
+bool config_file_sets(const fs::path& file, const std::string& key) {
+  if (file.empty()) return false;
+  std::ifstream in(file);
+  const auto parsed = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  return parsed.is_object() && parsed.contains(key);
+}
+
 // The run's config: preset, then the JSON file, then --set overrides, then --steps.
+// decay_steps follows the run's length unless set.
 TrainingConfig resolve_config(const TrainArgs& args) {
   TrainingConfig config = TrainingConfig::preset_named(args.preset);
   if (!args.config_file.empty()) {
@@ -58,6 +69,12 @@ TrainingConfig resolve_config(const TrainArgs& args) {
   }
   for (const std::string& setting : args.settings) config.apply_setting(setting);
   if (args.steps >= 0) config.steps = args.steps;
+  // The learning rate decays over the run's length unless decay_steps was given.
+  const bool decay_given =
+      std::any_of(args.settings.begin(), args.settings.end(),
+                  [](const std::string& s) { return s.rfind("decay_steps=", 0) == 0; }) ||
+      config_file_sets(args.config_file, "decay_steps");
+  if (!decay_given) config.trainer.adam.decay_steps = std::max<std::int64_t>(1, config.steps);
   return config;
 }
 
@@ -140,6 +157,10 @@ void run_train(const TrainArgs& args) {
     trainer.set_backend(std::move(backend));
   }
   if (root) fmt::print("network passes on: {}\n", trainer.backend().name());
+  if (!args.resume && config.trainer.statistics_warmup > 0) {
+    if (root) fmt::print("statistics warm-up: {} batches\n", config.trainer.statistics_warmup);
+    trainer.warm_up_statistics(config.trainer.statistics_warmup);
+  }
   std::optional<TrainingLog> log;
   if (root) log.emplace(log_path, trainer.steps_done());
 
@@ -160,28 +181,33 @@ void run_train(const TrainArgs& args) {
   ProgressBar bar(root ? "train" : "", config.steps, trainer.steps_done());
   const std::int64_t first_step = trainer.steps_done();
   auto last_checkpoint = std::chrono::steady_clock::now();
-  double loss_sum = 0.0;
+  double loss_sum = 0.0, norm_sum = 0.0;
   int loss_count = 0;
   std::int64_t window_start_step = trainer.steps_done();
   double window_start_time = bar.seconds();
   bool stopped = false;
   while (trainer.steps_done() < config.steps && !(stopped = stop_agreed())) {
     const TrainStep step = trainer.step();
-    loss_sum += step.loss, ++loss_count;
+    loss_sum += step.loss, norm_sum += step.gradient_norm, ++loss_count;
     if (!root) continue;
     if (step.step % args.log_every == 0 || step.step == config.steps) {
       const double now = bar.seconds();
       const double rate = (step.step - window_start_step) / std::max(1e-9, now - window_start_time);
-      log->write_step(step.step, loss_sum / loss_count, step.learning_rate, rate);
+      log->write_step(step.step, loss_sum / loss_count, step.learning_rate, rate,
+                      norm_sum / loss_count);
       bar.update(step.step,
                  fmt::format("loss {:.4f}  {:.1f} steps/s  {:.0f} samples/s", loss_sum / loss_count,
                              rate, rate * config.trainer.batch_size));
-      loss_sum = 0.0, loss_count = 0;
+      loss_sum = 0.0, norm_sum = 0.0, loss_count = 0;
       window_start_step = step.step, window_start_time = now;
     }
     if (!valid.empty() && (step.step % args.valid_every == 0 || step.step == config.steps)) {
-      ModelPredictor predictor(trainer.model());
-      const Evaluation e = evaluate_rollouts(predictor, valid);
+      // One thread per trajectory (Eigen runs each predictor's products on its own thread
+      // inside a parallel region; 0 leaves its process-wide setting alone).
+      const std::shared_ptr<const Model> model = trainer.model();
+      const Evaluation e = evaluate_rollouts_parallel(
+          [&] { return std::make_unique<ModelPredictor>(model, 0); }, valid,
+          std::max(1, omp_get_max_threads()));
       log->write_validation(step.step, e);
       fmt::print(stderr, "\nstep {}: validation translation {:.4f} m, rotation {:.2f} deg\n",
                  step.step, e.mean_translation, e.mean_rotation);

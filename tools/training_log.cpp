@@ -27,11 +27,12 @@ TrainingLog::TrainingLog(const std::filesystem::path& path, std::int64_t resume_
 }
 
 void TrainingLog::write_step(std::int64_t step, double loss, float learning_rate,
-                             double steps_per_second) {
+                             double steps_per_second, double gradient_norm) {
   out_ << nlohmann::json{{"step", step},
                          {"loss", loss},
                          {"learning_rate", learning_rate},
-                         {"steps_per_second", steps_per_second}}
+                         {"steps_per_second", steps_per_second},
+                         {"gradient_norm", gradient_norm}}
               .dump()
        << std::endl;
 }

@@ -16,7 +16,8 @@ class TrainingLog {
   // passes 0 and starts an empty log).
   TrainingLog(const std::filesystem::path& path, std::int64_t resume_step);
 
-  void write_step(std::int64_t step, double loss, float learning_rate, double steps_per_second);
+  void write_step(std::int64_t step, double loss, float learning_rate, double steps_per_second,
+                  double gradient_norm);
   void write_validation(std::int64_t step, const Evaluation& evaluation);
 
  private:

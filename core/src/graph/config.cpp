@@ -22,6 +22,9 @@ void GraphConfig::validate() const {
   if (floor_segments < 1 || floor_segments > 1024) {
     fail("floor_segments", floor_segments, "must be in 1..1024");
   }
+  if (!mesh_edges && !object_nodes) {
+    fail("mesh_edges", "false", "needs object_nodes: without both, nothing couples a body's nodes");
+  }
 }
 
 FeatureSizes feature_sizes(const GraphConfig& config) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <tuple>
 
 namespace fignet::detail {
@@ -27,10 +28,13 @@ float* put_direction(float* out, const Vec3& n) {
 // [x^t − x^{t−1}, …, x^{t−h+1} − x^{t−h}] (newest first), static properties, kinematic flag,
 // next-step displacement of kinematic nodes.
 template <class PositionAt>
-float* put_dynamic_features(float* out, int history, const SceneObject& object,
+float* put_dynamic_features(float* out, const GraphConfig& config, const SceneObject& object,
                             PositionAt position_at, const Vec3& next) {
+  const int history = config.history;
   for (int k = history; k >= 1; --k) out = put_vector(out, position_at(k) - position_at(k - 1));
-  *out++ = static_cast<float>(object.properties.mass);
+  // Kinematic bodies have mass 0: their log mass is taken as 0 too (the flag tells them apart).
+  const double mass = object.properties.mass;
+  *out++ = static_cast<float>(config.log_mass ? (mass > 0.0 ? std::log(mass) : 0.0) : mass);
   *out++ = static_cast<float>(object.properties.friction);
   *out++ = static_cast<float>(object.properties.restitution);
   *out++ = object.kinematic ? 1.0f : 0.0f;
@@ -50,7 +54,7 @@ void append_mesh_nodes(const GraphConfig& config, const SceneObject& object, con
     };
     const Vec3 next =
         object.kinematic ? Vec3(object.next_positions.row(i).transpose()) : Vec3::Zero();
-    float* end = put_dynamic_features(row, h, object, position_at, next);
+    float* end = put_dynamic_features(row, config, object, position_at, next);
     if (config.floor == FloorModel::kImplicit) {
       // [within d_c of the floor, height above it when within] (seed D.2's implicit floor).
       const double height = floor ? position_at(h).z() - floor->height : INFINITY;
@@ -63,7 +67,7 @@ void append_mesh_nodes(const GraphConfig& config, const SceneObject& object, con
 
 void append_object_node(const GraphConfig& config, const SceneObject& object, FeatureMatrix& out) {
   auto center_at = [&](int k) -> Vec3 { return object.centers.row(k).transpose(); };
-  put_dynamic_features(out.append_rows(1), config.history, object, center_at, object.next_center);
+  put_dynamic_features(out.append_rows(1), config, object, center_at, object.next_center);
 }
 
 namespace {

@@ -134,12 +134,17 @@ void GraphBuilder::build_scenes(std::span<const Scene> scenes,
       const int object_index = first_object + static_cast<int>(o);
       const int first = graph.num_mesh_nodes();
       const int v = object.mesh->num_vertices();
+      const bool internal_edges = config_.static_internal_edges || !object.kinematic;
       detail::append_mesh_nodes(config_, object, implicit_floor, graph.mesh_nodes);
-      detail::append_mesh_edges(object, first, graph.mesh_edges);
+      if (config_.mesh_edges && internal_edges) {
+        detail::append_mesh_edges(object, first, graph.mesh_edges);
+      }
       if (config_.object_nodes) {
         detail::append_object_node(config_, object, graph.object_nodes);
-        detail::append_object_mesh_edges(object, object_index, first, graph.object_to_mesh,
-                                         graph.mesh_to_object);
+        if (internal_edges) {
+          detail::append_object_mesh_edges(object, object_index, first, graph.object_to_mesh,
+                                           graph.mesh_to_object);
+        }
       }
       graph.node_object.insert(graph.node_object.end(), v, object_index);
       graph.node_kinematic.insert(graph.node_kinematic.end(), v, object.kinematic ? 1 : 0);

@@ -19,6 +19,9 @@ void write_training(H5::Group group, const TrainerConfig& config, const TrainerS
   write_attribute(group, "learning_rate_start", double{config.adam.learning_rate_start});
   write_attribute(group, "learning_rate_end", double{config.adam.learning_rate_end});
   write_attribute(group, "decay_steps", static_cast<long long>(config.adam.decay_steps));
+  write_attribute(group, "gradient_clip", double{config.gradient_clip});
+  write_attribute(group, "huber_delta", double{config.huber_delta});
+  write_attribute(group, "statistics_warmup", static_cast<long long>(config.statistics_warmup));
   write_attribute(group, "step", static_cast<long long>(state.step));
   write_attribute(group, "rng", state.rng);
   const hsize_t n = state.first_moment.size();
@@ -34,12 +37,19 @@ void read_training(const H5::Group& group, size_t parameters, const std::string&
   config.adam.learning_rate_start = static_cast<float>(read_double(group, "learning_rate_start"));
   config.adam.learning_rate_end = static_cast<float>(read_double(group, "learning_rate_end"));
   config.adam.decay_steps = read_integer(group, "decay_steps");
+  // Added later: absent in older checkpoints, which trained without them.
+  if (group.attrExists("gradient_clip"))
+    config.gradient_clip = static_cast<float>(read_double(group, "gradient_clip"));
+  if (group.attrExists("huber_delta"))
+    config.huber_delta = static_cast<float>(read_double(group, "huber_delta"));
+  if (group.attrExists("statistics_warmup"))
+    config.statistics_warmup = static_cast<int>(read_integer(group, "statistics_warmup"));
   state.step = read_integer(group, "step");
   state.rng = read_string(group, "rng");
   for (auto [name, out] : {std::pair("adam_first_moment", &state.first_moment),
                            std::pair("adam_second_moment", &state.second_moment)}) {
     const H5::DataSet dataset = group.openDataSet(name);
-    if (shape_of(dataset) != std::vector<hsize_t>{parameters}) {
+    if (shape_of(dataset, where) != std::vector<hsize_t>{parameters}) {
       throw FileError(
           fmt::format("{}: 'training/{}' does not have {} entries", where, name, parameters));
     }

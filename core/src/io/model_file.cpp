@@ -51,6 +51,11 @@ void write_config(H5::Group group, const ModelConfig& c) {
   write_attribute(group, "floor", std::string(floors[static_cast<int>(c.graph.floor)]));
   write_attribute(group, "floor_half_extent", c.graph.floor_half_extent);
   write_attribute(group, "floor_segments", static_cast<long long>(c.graph.floor_segments));
+  write_attribute(group, "mesh_edges", static_cast<long long>(c.graph.mesh_edges));
+  write_attribute(group, "static_internal_edges",
+                  static_cast<long long>(c.graph.static_internal_edges));
+  write_attribute(group, "log_mass", static_cast<long long>(c.graph.log_mass));
+  write_attribute(group, "noise", std::string(c.noise == NoiseKind::kRigid ? "rigid" : "vertex"));
 }
 
 ModelConfig read_config(const H5::Group& group) {
@@ -84,6 +89,20 @@ ModelConfig read_config(const H5::Group& group) {
     throw ConfigError(fmt::format("config/floor = '{}' (must be mesh, implicit or none)", floor));
   c.graph.floor_half_extent = read_double(group, "floor_half_extent");
   c.graph.floor_segments = static_cast<int>(read_integer(group, "floor_segments"));
+  // Added after the first model files: absent means what those files were made with.
+  auto flag = [&](const char* name, bool absent) {
+    return group.attrExists(name) ? read_integer(group, name) != 0 : absent;
+  };
+  c.graph.mesh_edges = flag("mesh_edges", true);
+  c.graph.static_internal_edges = flag("static_internal_edges", true);
+  c.graph.log_mass = flag("log_mass", false);
+  if (group.attrExists("noise")) {
+    const std::string noise = read_string(group, "noise");
+    if (noise != "vertex" && noise != "rigid") {
+      throw ConfigError(fmt::format("config/noise = '{}' (must be vertex or rigid)", noise));
+    }
+    c.noise = noise == "rigid" ? NoiseKind::kRigid : NoiseKind::kVertex;
+  }
   c.validate();
   return c;
 }
@@ -150,7 +169,7 @@ Model read_model_contents(const H5::H5File& file, const std::string& where) {
         throw FileError(fmt::format("{}: missing tensor '{}'", where, object));
       }
       const H5::DataSet dataset = group.openDataSet(t.name);
-      const auto shape = hdf5::shape_of(dataset);
+      const auto shape = hdf5::shape_of(dataset, where);
       if (shape != std::vector<hsize_t>{hsize_t(t.rows), hsize_t(t.cols)}) {
         throw FileError(fmt::format("{}: tensor '{}' has shape [{}], expected [{}, {}]", where,
                                     object, fmt::join(shape, ", "), t.rows, t.cols));
@@ -168,7 +187,7 @@ Model read_model_contents(const H5::H5File& file, const std::string& where) {
       for (auto [dataset_name, out] :
            {std::pair("sum", &sum), std::pair("sum_squares", &squares)}) {
         const H5::DataSet dataset = g.openDataSet(dataset_name);
-        if (hdf5::shape_of(dataset) != std::vector<hsize_t>{hsize_t(normalizer->size())}) {
+        if (hdf5::shape_of(dataset, where) != std::vector<hsize_t>{hsize_t(normalizer->size())}) {
           throw FileError(fmt::format("{}: '{}/{}' does not have {} entries", where, object,
                                       dataset_name, normalizer->size()));
         }

@@ -62,7 +62,7 @@ Network::Network(const ModelConfig& config)
     : config_((config.validate(), config)),
       sizes_(feature_sizes(config.graph)),
       face_edges_(config.graph.collisions == CollisionEdges::kFaceFace) {
-  edge_kinds_.push_back(EdgeKind::kMesh);
+  if (config_.graph.mesh_edges) edge_kinds_.push_back(EdgeKind::kMesh);
   if (config_.graph.object_nodes) {
     edge_kinds_.push_back(EdgeKind::kObjectToMesh);
     edge_kinds_.push_back(EdgeKind::kMeshToObject);

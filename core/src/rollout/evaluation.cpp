@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <exception>
 
 #include "fignet/error.h"
 #include "fignet/rollout/rollout.h"
@@ -76,6 +77,34 @@ Evaluation summarize(const EvaluationTotals& totals, const EvaluationOptions& op
 Evaluation evaluate_rollouts(AccelerationPredictor& predictor, std::span<const Trajectory> truths,
                              const EvaluationOptions& options) {
   return summarize(evaluate_rollout_totals(predictor, truths, options), options);
+}
+
+Evaluation evaluate_rollouts_parallel(
+    const std::function<std::unique_ptr<AccelerationPredictor>()>& make_predictor,
+    std::span<const Trajectory> truths, int threads, const EvaluationOptions& options) {
+  EvaluationOptions quiet = options;
+  quiet.on_trajectory = nullptr;
+  const int n = static_cast<int>(truths.size());
+  std::vector<EvaluationTotals> each(truths.size());
+  std::exception_ptr failure;
+#pragma omp parallel num_threads(std::max(1, std::min(threads, n)))
+  {
+    std::unique_ptr<AccelerationPredictor> predictor;
+#pragma omp for schedule(dynamic, 1)
+    for (int i = 0; i < n; ++i) {
+      try {
+        if (!predictor) predictor = make_predictor();
+        each[i] = evaluate_rollout_totals(*predictor, truths.subspan(i, 1), quiet);
+      } catch (...) {
+#pragma omp critical
+        if (!failure) failure = std::current_exception();
+      }
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+  EvaluationTotals totals;
+  for (const EvaluationTotals& t : each) totals += t;
+  return summarize(totals, options);
 }
 
 EvaluationTotals& EvaluationTotals::operator+=(const EvaluationTotals& other) {

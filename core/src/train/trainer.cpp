@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "fignet/error.h"
 
@@ -85,18 +86,13 @@ std::mt19937_64 Trainer::step_generator(std::int64_t step) const {
 void Trainer::prepare_batch(const std::vector<SampleRef>& batch, std::mt19937_64& noise,
                             bool accumulate) {
   const auto start = std::chrono::steady_clock::now();
-  const int h = config_.graph.history;
-  scenes_.resize(batch.size());
-  scene_targets_.resize(batch.size());
-  for (size_t b = 0; b < batch.size(); ++b) {
-    if (batch[b].trajectory < 0 || batch[b].trajectory >= static_cast<int>(data_.size())) {
+  for (const SampleRef& sample : batch) {
+    if (sample.trajectory < 0 || sample.trajectory >= static_cast<int>(data_.size())) {
       throw ConfigError(fmt::format("trainer: sample of trajectory {} (this process has {})",
-                                    batch[b].trajectory, data_.size()));
+                                    sample.trajectory, data_.size()));
     }
-    make_noisy_sample(data_[batch[b].trajectory], batch[b].frame, h, config_.noise_std, noise,
-                      scenes_[b], scene_targets_[b]);
   }
-  build_batch_graph();
+  build_batch_graph(batch, noise);
   gather_targets(graph_, scene_targets_, targets_, in_loss_);
   times_.build += seconds_since(start);
   if (accumulate) {
@@ -106,12 +102,26 @@ void Trainer::prepare_batch(const std::vector<SampleRef>& batch, std::mt19937_64
   }
 }
 
-void Trainer::build_batch_graph() {
+void Trainer::build_batch_graph(const std::vector<SampleRef>& batch, std::mt19937_64& noise) {
+  const int h = config_.graph.history;
+  const int scenes = static_cast<int>(batch.size());
+  scenes_.resize(scenes);
+  scene_targets_.resize(scenes);
+  // One noise seed per scene, drawn in scene order: the noise does not depend on the threads.
+  scene_seeds_.resize(scenes);
+  for (std::uint64_t& seed : scene_seeds_) seed = noise();
+  auto make_samples = [&](int begin, int end) {
+    for (int b = begin; b < end; ++b) {
+      std::mt19937_64 rng(scene_seeds_[b]);
+      make_noisy_sample(data_[batch[b].trajectory], batch[b].frame, h, config_.noise_std,
+                        config_.noise, rng, scenes_[b], scene_targets_[b]);
+    }
+  };
   // Contiguous runs of scenes per thread; small batches stay on the calling thread.
   constexpr int kMinScenesPerPart = 4;
-  const int scenes = static_cast<int>(scenes_.size());
   const int parts = std::clamp(std::min(omp_get_max_threads(), scenes / kMinScenesPerPart), 1, 64);
   if (parts == 1) {
+    make_samples(0, scenes);
     builders_[0].build(scenes_, graph_);
     return;
   }
@@ -127,6 +137,7 @@ void Trainer::build_batch_graph() {
 #pragma omp parallel for num_threads(parts) schedule(static, 1)
   for (int i = 0; i < parts; ++i) {
     try {
+      make_samples(scenes * i / parts, scenes * (i + 1) / parts);
       builders_[i].build(part_of(i), i == 0 ? graph_ : part_graphs_[i]);
     } catch (...) {
 #pragma omp critical
@@ -135,6 +146,29 @@ void Trainer::build_batch_graph() {
   }
   if (failure) std::rethrow_exception(failure);
   for (int i = 1; i < parts; ++i) append_graph(part_graphs_[i], graph_);
+}
+
+void Trainer::clip_gradient() {
+  double squares = 0.0;
+  for (float g : grads_) squares += double(g) * g;
+  const double norm = std::sqrt(squares);
+  last_gradient_norm_ = norm;
+  const float limit = trainer_config_.gradient_clip;
+  if (limit <= 0.0f || norm <= limit) return;
+  const float scale = static_cast<float>(limit / norm);
+  for (float& g : grads_) g *= scale;
+}
+
+void Trainer::warm_up_statistics(int batches) {
+  std::vector<SampleRef> batch(static_cast<size_t>(local_batch_size(trainer_config_.batch_size)));
+  for (int i = 0; i < batches; ++i) {
+    // Steps numbered from -1 down: apart from every training step's draws.
+    std::mt19937_64 generator = step_generator(-1 - static_cast<std::int64_t>(i));
+    std::uniform_int_distribution<size_t> pick(0, samples_.size() - 1);
+    for (SampleRef& sample : batch) sample = samples_[pick(generator)];
+    std::mt19937_64 noise(generator());
+    prepare_batch(batch, noise, /*accumulate=*/true);
+  }
 }
 
 void Trainer::set_backend(std::unique_ptr<NetworkBackend> backend) {
@@ -179,13 +213,19 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
       backend_->forward(params_.data(), normalizers_, graph_, with_gradient);
   normalized_targets_.resize(targets_.rows(), 3);
   normalizers_.target.normalize(targets_, normalized_targets_);
+  // Squared error, or Huber's: quadratic within delta, linear beyond (scaled to match at 0).
+  const double delta = trainer_config_.huber_delta;
+  auto loss_of = [delta](double error) {
+    const double size = std::abs(error);
+    return delta <= 0.0 || size <= delta ? error * error : delta * (2.0 * size - delta);
+  };
+  auto slope_of = [delta](double error) {
+    return delta <= 0.0 || std::abs(error) <= delta ? error : std::copysign(delta, error);
+  };
   double local_squares = 0.0;
   for (Eigen::Index i = 0; i < output.rows(); ++i) {
     if (!in_loss_[i]) continue;
-    for (int c = 0; c < 3; ++c) {
-      const double error = output(i, c) - normalized_targets_(i, c);
-      local_squares += error * error;
-    }
+    for (int c = 0; c < 3; ++c) local_squares += loss_of(output(i, c) - normalized_targets_(i, c));
   }
   // The mean is over every process's dynamic nodes: one small sum for the count and loss.
   double totals[2] = {static_cast<double>(std::count(in_loss_.begin(), in_loss_.end(), 1)),
@@ -199,12 +239,13 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
     for (Eigen::Index i = 0; i < output.rows(); ++i) {
       if (!in_loss_[i]) continue;
       for (int c = 0; c < 3; ++c)
-        d_output_(i, c) = scale * (output(i, c) - normalized_targets_(i, c));
+        d_output_(i, c) = scale * slope_of(output(i, c) - normalized_targets_(i, c));
     }
     std::fill(grads_.begin(), grads_.end(), 0.0f);
     backend_->backward(params_.data(), grads_.data(), graph_, d_output_);
     // Each process's gradient is its part of the global mean's: their sum is the whole.
     if (reduce) collective_->sum(std::span<float>(grads_.data(), grads_.size()));
+    clip_gradient();
   }
   return totals[1] / (3 * count);
 }
@@ -224,6 +265,7 @@ TrainStep Trainer::step_on(const std::vector<SampleRef>& samples, std::uint64_t 
   result.learning_rate = adam_.learning_rate();
   auto start = std::chrono::steady_clock::now();
   result.loss = loss_and_gradient(true, true);
+  result.gradient_norm = last_gradient_norm_;
   times_.network += seconds_since(start);
   start = std::chrono::steady_clock::now();
   adam_.update(params_, grads_);

@@ -13,7 +13,7 @@ std::vector<SampleRef> enumerate_samples(const std::vector<Trajectory>& data, in
 }
 
 void make_noisy_sample(const Trajectory& trajectory, int frame, int history, double noise_std,
-                       std::mt19937_64& rng, Scene& scene, Points& targets) {
+                       NoiseKind kind, std::mt19937_64& rng, Scene& scene, Points& targets) {
   scene_at_frame(trajectory, frame, history, scene);
   Eigen::Index rows = 0;
   for (const SceneObject& object : scene.objects) rows += object.mesh->num_vertices();
@@ -29,11 +29,37 @@ void make_noisy_sample(const Trajectory& trajectory, int frame, int history, dou
     }
     // Random walk over the history steps: noise[k] = Σ_{j<=k} velocity noise, noise[0] = 0.
     Points noise = Points::Zero(v, 3);
-    for (int k = 1; k <= history; ++k) {
-      if (noise_std > 0.0) {
-        for (Eigen::Index i = 0; i < noise.size(); ++i) noise.data()[i] += normal(rng);
+    if (kind == NoiseKind::kVertex) {
+      for (int k = 1; k <= history; ++k) {
+        if (noise_std > 0.0) {
+          for (Eigen::Index i = 0; i < noise.size(); ++i) noise.data()[i] += normal(rng);
+        }
+        object.positions.middleRows(k * v, v) += noise;
       }
-      object.positions.middleRows(k * v, v) += noise;
+    } else {
+      // The body's pose walks: a translation and a rotation about its centre, scaled so that its
+      // farthest vertex moves by about the translation's amount.
+      const double radius = std::max(object.mesh->vertices().rowwise().norm().maxCoeff(), 1e-3);
+      Vec3 translation = Vec3::Zero(), rotation = Vec3::Zero();
+      for (int k = 1; k <= history; ++k) {
+        if (noise_std > 0.0) {
+          for (int c = 0; c < 3; ++c) translation[c] += normal(rng);
+          for (int c = 0; c < 3; ++c) rotation[c] += normal(rng) / radius;
+        }
+        const Vec3 center = object.centers.row(k).transpose();
+        const Eigen::Matrix3d turn =
+            rotation.norm() > 0.0
+                ? Eigen::AngleAxisd(rotation.norm(), rotation.normalized()).toRotationMatrix()
+                : Eigen::Matrix3d::Identity();
+        auto step = object.positions.middleRows(k * v, v);
+        for (Eigen::Index i = 0; i < v; ++i) {
+          const Vec3 x = step.row(i).transpose();
+          const Vec3 moved = center + turn * (x - center) + translation;
+          noise.row(i) = (moved - x).transpose();
+          step.row(i) = moved.transpose();
+        }
+        object.centers.row(k) += translation.transpose();
+      }
     }
     // Target from the clean next frame, corrected by the last position's noise.
     const Points next_positions =

@@ -76,7 +76,19 @@ const std::vector<std::pair<std::string, Field>>& fields() {
                               {{FloorModel::kMesh, "mesh"},
                                {FloorModel::kImplicit, "implicit"},
                                {FloorModel::kNone, "none"}})},
+      {"floor_segments",
+       plain<int>([](TrainingConfig & c) -> auto& { return c.model.graph.floor_segments; })},
+      {"floor_half_extent",
+       plain<double>([](TrainingConfig & c) -> auto& { return c.model.graph.floor_half_extent; })},
+      {"mesh_edges",
+       plain<bool>([](TrainingConfig & c) -> auto& { return c.model.graph.mesh_edges; })},
+      {"static_internal_edges", plain<bool>([](TrainingConfig & c) -> auto& {
+         return c.model.graph.static_internal_edges;
+       })},
+      {"log_mass", plain<bool>([](TrainingConfig & c) -> auto& { return c.model.graph.log_mass; })},
       {"noise_std", plain<double>([](TrainingConfig & c) -> auto& { return c.model.noise_std; })},
+      {"noise", named_enum<NoiseKind>([](TrainingConfig & c) -> auto& { return c.model.noise; },
+                                      {{NoiseKind::kVertex, "vertex"}, {NoiseKind::kRigid, "rigid"}})},
       {"normalizer_max_accumulations", plain<std::int64_t>([](TrainingConfig & c) -> auto& {
          return c.model.normalizer_max_accumulations;
        })},
@@ -90,6 +102,11 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.adam.learning_rate_end; })},
       {"decay_steps",
        plain<std::int64_t>([](TrainingConfig & c) -> auto& { return c.trainer.adam.decay_steps; })},
+      {"gradient_clip",
+       plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.gradient_clip; })},
+      {"huber_delta", plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.huber_delta; })},
+      {"statistics_warmup",
+       plain<int>([](TrainingConfig & c) -> auto& { return c.trainer.statistics_warmup; })},
       {"data_seed",
        plain<std::uint64_t>([](TrainingConfig & c) -> auto& { return c.trainer.seed; })},
       {"steps", plain<std::int64_t>([](TrainingConfig & c) -> auto& { return c.steps; })},
@@ -201,6 +218,16 @@ void TrainingConfig::validate() const {
     throw ConfigError(fmt::format("decay_steps = {} (must be >= 1)", adam.decay_steps));
   }
   if (steps < 0) throw ConfigError(fmt::format("steps = {} (must be >= 0)", steps));
+  for (const auto& [name, value] : {std::pair("gradient_clip", trainer.gradient_clip),
+                                    std::pair("huber_delta", trainer.huber_delta)}) {
+    if (!(value >= 0.0f) || !std::isfinite(value)) {
+      throw ConfigError(fmt::format("{} = {} (must be >= 0; 0 turns it off)", name, value));
+    }
+  }
+  if (trainer.statistics_warmup < 0 || trainer.statistics_warmup > 1'000'000) {
+    throw ConfigError(fmt::format("statistics_warmup = {} (must be in 0..1000000 batches)",
+                                  trainer.statistics_warmup));
+  }
 }
 
 }  // namespace fignet

@@ -12,12 +12,20 @@
 
 namespace fignet {
 
+// How training noise corrupts the input positions (the velocities the network sees).
+enum class NoiseKind {
+  kVertex,  // an independent random walk per vertex (GNS); Kabsch removes it in rollouts
+  kRigid,   // a random walk of each body's pose, vertices and centre together: the whole-body
+            // drift that rollouts accumulate
+};
+
 struct ModelConfig {
   std::string preset = "paper";
   GraphConfig graph;
   int latent_size = 128;           // L: hidden and output width of every MLP (seed C.2)
   int message_passing_steps = 10;  // M, unshared weights (seed C.1.2)
   double noise_std = 3e-4;         // random-walk noise at the last input position, metres
+  NoiseKind noise = NoiseKind::kVertex;
   std::int64_t normalizer_max_accumulations = 1'000'000;  // statistics freeze afterwards
   double time_step = 1.0 / 48.0;   // seconds between the frames the model was trained on
   Vec3 gravity = Vec3(0, 0, -10);  // the training data's gravity

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -34,6 +35,12 @@ struct Evaluation {
 
 Evaluation evaluate_rollouts(AccelerationPredictor& predictor, std::span<const Trajectory> truths,
                              const EvaluationOptions& options = {});
+// The same with the trajectories shared among `threads` threads, each with a predictor of its own
+// from `make_predictor`; results are combined in trajectory order, so they equal the one-thread
+// evaluation's (on_trajectory is not called).
+Evaluation evaluate_rollouts_parallel(
+    const std::function<std::unique_ptr<AccelerationPredictor>()>& make_predictor,
+    std::span<const Trajectory> truths, int threads, const EvaluationOptions& options = {});
 
 // The same in two halves, for evaluations split across processes: each rolls out its share into
 // totals, the totals are concatenated (in trajectory order) and summarised once.

@@ -26,6 +26,14 @@ struct TrainerConfig {
   int batch_size = 4;  // scenes per step over all processes, concatenated into graphs
   AdamConfig adam;     // learning rate 1e-3 → 1e-4 over adam.decay_steps
   std::uint64_t seed = 1;
+  // The gradient is scaled down to this global L2 norm when longer (0: never). One impact's
+  // 10–25σ targets otherwise steer a whole step.
+  float gradient_clip = 0.0f;
+  // Huber loss on the normalised error with this threshold (0: mean squared error).
+  float huber_delta = 0.0f;
+  // Batches whose only use is the input and target statistics, before the first update of a new
+  // run, so that early updates see settled normalisers.
+  int statistics_warmup = 0;
 };
 
 // Everything besides the model that makes training continue exactly where it stopped: the
@@ -48,6 +56,7 @@ struct TrainStep {
   std::int64_t step = 0;  // steps done, this one included
   double loss = 0.0;      // mean squared normalised error over the batch's dynamic nodes
   float learning_rate = 0.0f;
+  double gradient_norm = 0.0;  // global L2 norm of the gradient, before any clipping
 };
 
 class Trainer {
@@ -64,6 +73,9 @@ class Trainer {
 
   // One optimisation step on a random batch (this process's share of it).
   TrainStep step();
+  // Accumulates the statistics of `batches` random batches without updating the parameters (a
+  // new run's warm-up; the batches are drawn apart from those of the training steps).
+  void warm_up_statistics(int batches);
   // One step on the given samples of this process's data, with noise from `noise_seed`: what
   // step() does after drawing them. Every process calls it together.
   TrainStep step_on(const std::vector<SampleRef>& samples, std::uint64_t noise_seed);
@@ -100,13 +112,16 @@ class Trainer {
  private:
   // Builds the batch graph and targets; accumulates statistics while they are not frozen.
   void prepare_batch(const std::vector<SampleRef>& batch, std::mt19937_64& noise, bool accumulate);
-  // Builds graph_ from scenes_, in parallel parts for large batches.
-  void build_batch_graph();
+  // Fills scenes_ and their targets for `batch` (noise from one seed per scene, drawn in order
+  // from `noise`) and builds graph_, in parallel parts for large batches.
+  void build_batch_graph(const std::vector<SampleRef>& batch, std::mt19937_64& noise);
   // Adds this step's statistics of every input and of the targets, summed over processes.
   void accumulate_statistics();
   // Mean over every process's dynamic nodes; with `reduce`, counts and gradients are summed
   // over processes.
   double loss_and_gradient(bool with_gradient, bool reduce);
+  // Scales grads_ to trainer_config_.gradient_clip when longer.
+  void clip_gradient();
   std::mt19937_64 step_generator(std::int64_t step) const;
 
   ModelConfig config_;
@@ -131,7 +146,9 @@ class Trainer {
   std::vector<std::uint8_t> in_loss_;
   Normalizers batch_statistics_;
   std::vector<double> statistics_buffer_;
+  std::vector<std::uint64_t> scene_seeds_;
   TrainerTimes times_;
+  double last_gradient_norm_ = 0.0;
 };
 
 }  // namespace fignet

@@ -7,6 +7,7 @@
 
 #include "fignet/data/trajectory.h"
 #include "fignet/graph/graph.h"
+#include "fignet/model/config.h"
 
 namespace fignet {
 
@@ -21,9 +22,11 @@ std::vector<SampleRef> enumerate_samples(const std::vector<Trajectory>& data, in
 // per-step velocity noise of std noise_std/sqrt(h), summed over the history, so the current
 // position's noise has std noise_std and the oldest none. Writes each node's target
 // x^{t+1} − 2x̃^t + x̃^{t−1} + n^t, which asks the model to undo the velocity noise (rows follow
-// scene.objects; kinematic rows are zero).
+// scene.objects; kinematic rows are zero). NoiseKind::kRigid walks each body's pose instead:
+// translation steps of std noise_std/sqrt(h) and rotation steps of that over the body's radius,
+// applied to its vertices and centre together.
 void make_noisy_sample(const Trajectory& trajectory, int frame, int history, double noise_std,
-                       std::mt19937_64& rng, Scene& scene, Points& targets);
+                       NoiseKind kind, std::mt19937_64& rng, Scene& scene, Points& targets);
 
 // Stacks per-scene targets into graph row order (each scene's floor nodes get zero rows) and
 // marks which rows count in the loss (dynamic nodes).
