@@ -5,11 +5,11 @@
 
 #include <algorithm>
 #include <atomic>
-#include <nlohmann/json.hpp>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 
@@ -205,9 +205,9 @@ void run_train(const TrainArgs& args) {
       // One thread per trajectory (Eigen runs each predictor's products on its own thread
       // inside a parallel region; 0 leaves its process-wide setting alone).
       const std::shared_ptr<const Model> model = trainer.model();
-      const Evaluation e = evaluate_rollouts_parallel(
-          [&] { return std::make_unique<ModelPredictor>(model, 0); }, valid,
-          std::max(1, omp_get_max_threads()));
+      const Evaluation e =
+          evaluate_rollouts_parallel([&] { return std::make_unique<ModelPredictor>(model, 0); },
+                                     valid, std::max(1, omp_get_max_threads()));
       log->write_validation(step.step, e);
       fmt::print(stderr, "\nstep {}: validation translation {:.4f} m, rotation {:.2f} deg\n",
                  step.step, e.mean_translation, e.mean_rotation);

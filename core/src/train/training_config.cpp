@@ -87,8 +87,9 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        })},
       {"log_mass", plain<bool>([](TrainingConfig & c) -> auto& { return c.model.graph.log_mass; })},
       {"noise_std", plain<double>([](TrainingConfig & c) -> auto& { return c.model.noise_std; })},
-      {"noise", named_enum<NoiseKind>([](TrainingConfig & c) -> auto& { return c.model.noise; },
-                                      {{NoiseKind::kVertex, "vertex"}, {NoiseKind::kRigid, "rigid"}})},
+      {"noise",
+       named_enum<NoiseKind>([](TrainingConfig & c) -> auto& { return c.model.noise; },
+                             {{NoiseKind::kVertex, "vertex"}, {NoiseKind::kRigid, "rigid"}})},
       {"normalizer_max_accumulations", plain<std::int64_t>([](TrainingConfig & c) -> auto& {
          return c.model.normalizer_max_accumulations;
        })},
@@ -104,7 +105,8 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        plain<std::int64_t>([](TrainingConfig & c) -> auto& { return c.trainer.adam.decay_steps; })},
       {"gradient_clip",
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.gradient_clip; })},
-      {"huber_delta", plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.huber_delta; })},
+      {"huber_delta",
+       plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.huber_delta; })},
       {"statistics_warmup",
        plain<int>([](TrainingConfig & c) -> auto& { return c.trainer.statistics_warmup; })},
       {"data_seed",
