@@ -77,6 +77,24 @@ TEST(Trainer, BatchesDoNotDependOnTheThreadCount) {
   EXPECT_EQ(one.second, four.second);
 }
 
+// Huber's loss equals the squared error within delta and grows only linearly beyond it.
+TEST(Trainer, HuberLossIsQuadraticWithinDeltaAndLinearBeyond) {
+  const auto data = spinning_cubes(10);
+  auto loss_with = [&](float delta) {
+    TrainerConfig trainer_config;
+    trainer_config.huber_delta = delta;
+    Trainer trainer(small_model(), trainer_config, data);
+    trainer.warm_up_statistics(1);  // statistics, the parameters untouched
+    return trainer.evaluate_loss(trainer.samples());
+  };
+  const double squared = loss_with(0.0f);
+  ASSERT_GT(squared, 0.0);
+  EXPECT_DOUBLE_EQ(loss_with(1e6f), squared);
+  const double huber = loss_with(0.05f);
+  EXPECT_LT(huber, squared);
+  EXPECT_GT(huber, 0.0);
+}
+
 TEST(Trainer, IsDeterministicForASeed) {
   const auto data = spinning_cubes(10);
   ModelConfig config = small_model();
