@@ -9,7 +9,6 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 
@@ -49,14 +48,6 @@ extern "C" void request_stop(int) {
   stop_requested = 1;
 }
 
-// Whether the JSON config file names `key` (false without a file).
-bool config_file_sets(const fs::path& file, const std::string& key) {
-  if (file.empty()) return false;
-  std::ifstream in(file);
-  const auto parsed = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  return parsed.is_object() && parsed.contains(key);
-}
-
 // The run's config: preset, then the JSON file, then --set overrides, then --steps.
 // decay_steps follows the run's length unless set.
 TrainingConfig resolve_config(const TrainArgs& args) {
@@ -70,11 +61,9 @@ TrainingConfig resolve_config(const TrainArgs& args) {
   for (const std::string& setting : args.settings) config.apply_setting(setting);
   if (args.steps >= 0) config.steps = args.steps;
   // The learning rate decays over the run's length unless decay_steps was given.
-  const bool decay_given =
-      std::any_of(args.settings.begin(), args.settings.end(),
-                  [](const std::string& s) { return s.rfind("decay_steps=", 0) == 0; }) ||
-      config_file_sets(args.config_file, "decay_steps");
-  if (!decay_given) config.trainer.adam.decay_steps = std::max<std::int64_t>(1, config.steps);
+  if (!config.decay_steps_given) {
+    config.trainer.adam.decay_steps = std::max<std::int64_t>(1, config.steps);
+  }
   return config;
 }
 

@@ -89,8 +89,7 @@ struct StepCache {
 
 class CudaBackend final : public NetworkBackend {
  public:
-  CudaBackend(const Network& network, const CudaOptions& options)
-      : network_(network), options_(options) {
+  CudaBackend(const Network& network, const CudaOptions& options) : network_(network) {
     const int devices = device_count();
     if (options.device < 0 || options.device >= devices) {
       throw DeviceError(fmt::format("CUDA device {} requested; this process sees {} device{}",
@@ -207,7 +206,6 @@ class CudaBackend final : public NetworkBackend {
   }
 
   const Network& network_;
-  CudaOptions options_;
   std::string name_;
   cudaStream_t stream_ = nullptr;
   cublasHandle_t blas_ = nullptr;

@@ -62,5 +62,19 @@ TEST(TrainingConfig, BadInputNamesTheField) {
   EXPECT_NE(error_of([&] { config.validate(); }).find("batch_size = 0"), std::string::npos);
 }
 
+// fignet train lets decay_steps follow --steps unless a --set or --config named it.
+TEST(TrainingConfig, RemembersWhetherDecayStepsWasGiven) {
+  TrainingConfig config = TrainingConfig::preset_named("small");
+  config.apply_json("{\"batch_size\": 8, \"steps\": 100}", "f.json");
+  config.apply_setting("latent_size=32");
+  EXPECT_FALSE(config.decay_steps_given);
+  config.apply_setting("decay_steps=50");
+  EXPECT_TRUE(config.decay_steps_given);
+  EXPECT_EQ(config.trainer.adam.decay_steps, 50);
+  TrainingConfig from_file = TrainingConfig::preset_named("small");
+  from_file.apply_json("{\"decay_steps\": 70}", "f.json");
+  EXPECT_TRUE(from_file.decay_steps_given);
+}
+
 }  // namespace
 }  // namespace fignet

@@ -128,17 +128,14 @@ void Trainer::build_batch_graph(const std::vector<SampleRef>& batch, std::mt1993
   while (static_cast<int>(builders_.size()) < parts) builders_.emplace_back(config_.graph);
   if (static_cast<int>(part_graphs_.size()) < parts) part_graphs_.resize(parts);
   const std::span<const Scene> all(scenes_);
-  auto part_of = [&](int i) {
-    const int begin = scenes * i / parts, end = scenes * (i + 1) / parts;
-    return all.subspan(begin, end - begin);
-  };
   // The first part is built straight into the batch graph, the others beside it.
   std::exception_ptr failure;
 #pragma omp parallel for num_threads(parts) schedule(static, 1)
   for (int i = 0; i < parts; ++i) {
     try {
-      make_samples(scenes * i / parts, scenes * (i + 1) / parts);
-      builders_[i].build(part_of(i), i == 0 ? graph_ : part_graphs_[i]);
+      const int begin = scenes * i / parts, end = scenes * (i + 1) / parts;
+      make_samples(begin, end);
+      builders_[i].build(all.subspan(begin, end - begin), i == 0 ? graph_ : part_graphs_[i]);
     } catch (...) {
 #pragma omp critical
       if (!failure) failure = std::current_exception();
@@ -160,14 +157,10 @@ void Trainer::clip_gradient() {
 }
 
 void Trainer::warm_up_statistics(int batches) {
-  std::vector<SampleRef> batch(static_cast<size_t>(local_batch_size(trainer_config_.batch_size)));
   for (int i = 0; i < batches; ++i) {
-    // Steps numbered from -1 down: apart from every training step's draws.
-    std::mt19937_64 generator = step_generator(-1 - static_cast<std::int64_t>(i));
-    std::uniform_int_distribution<size_t> pick(0, samples_.size() - 1);
-    for (SampleRef& sample : batch) sample = samples_[pick(generator)];
-    std::mt19937_64 noise(generator());
-    prepare_batch(batch, noise, /*accumulate=*/true);
+    // Counters from -1 down: apart from every training step's draws.
+    std::mt19937_64 noise(draw_batch(-1 - static_cast<std::int64_t>(i), batch_));
+    prepare_batch(batch_, noise, /*accumulate=*/true);
   }
 }
 
@@ -250,12 +243,17 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
   return totals[1] / (3 * count);
 }
 
-TrainStep Trainer::step() {
-  std::mt19937_64 generator = step_generator(adam_.step());
+std::uint64_t Trainer::draw_batch(std::int64_t counter, std::vector<SampleRef>& batch) const {
+  std::mt19937_64 generator = step_generator(counter);
   std::uniform_int_distribution<size_t> pick(0, samples_.size() - 1);
-  batch_.resize(static_cast<size_t>(local_batch_size(trainer_config_.batch_size)));
-  for (SampleRef& sample : batch_) sample = samples_[pick(generator)];
-  return step_on(batch_, generator());
+  batch.resize(static_cast<size_t>(local_batch_size(trainer_config_.batch_size)));
+  for (SampleRef& sample : batch) sample = samples_[pick(generator)];
+  return generator();
+}
+
+TrainStep Trainer::step() {
+  const std::uint64_t noise_seed = draw_batch(adam_.step(), batch_);
+  return step_on(batch_, noise_seed);
 }
 
 TrainStep Trainer::step_on(const std::vector<SampleRef>& samples, std::uint64_t noise_seed) {

@@ -131,6 +131,7 @@ void set_field(TrainingConfig& config, const std::string& key, const json& value
   }
   try {
     field->set(config, value);
+    if (key == "decay_steps") config.decay_steps_given = true;
   } catch (const json::exception&) {
     throw ConfigError(fmt::format("{}: '{}' = {} has the wrong type", where, key, value.dump()));
   } catch (const ConfigError& e) {

@@ -49,7 +49,6 @@ struct TrainerState {
 // training: building graphs on the CPU, input statistics, the network's passes, or Adam.
 struct TrainerTimes {
   double build = 0.0, statistics = 0.0, network = 0.0, optimizer = 0.0;
-  double total() const { return build + statistics + network + optimizer; }
 };
 
 struct TrainStep {
@@ -123,6 +122,9 @@ class Trainer {
   // Scales grads_ to trainer_config_.gradient_clip when longer.
   void clip_gradient();
   std::mt19937_64 step_generator(std::int64_t step) const;
+  // Fills `batch` with this process's share of the batch of draw number `counter` (a step's
+  // number; warm-up batches count from -1 down) and returns the batch's noise seed.
+  std::uint64_t draw_batch(std::int64_t counter, std::vector<SampleRef>& batch) const;
 
   ModelConfig config_;
   TrainerConfig trainer_config_;

@@ -16,6 +16,9 @@ struct TrainingConfig {
   ModelConfig model;
   TrainerConfig trainer;
   std::int64_t steps = 1'000'000;  // total optimisation steps of the run
+  // Whether apply_json or apply_setting named decay_steps: otherwise a run's learning rate
+  // decays over its own length (fignet train sets decay_steps to steps). Not a saved field.
+  bool decay_steps_given = false;
 
   // The model preset ("paper" or "small") with the trainer defaults that suit it.
   static TrainingConfig preset_named(std::string_view name);
