@@ -5,7 +5,9 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <cmath>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 
 #include "fignet/bullet/conversions.h"
@@ -79,19 +81,26 @@ struct FIGNetDynamicsWorld::Impl {
   FIGNetStepStats stats;
   std::vector<std::pair<Vec3, Vec3>> face_lines;  // last step's face–face edges, for drawing
 
+  std::optional<GraphBuilder> contact_query;  // which bodies have collision edges
+
   // Per-step scratch.
   Scene scene;
   std::vector<btRigidBody*> dynamic_bodies;  // all dynamic rigid bodies of the world
-  std::vector<btRigidBody*> simulated;       // scene.objects[0 … simulated.size()) in order
+  std::vector<btRigidBody*> moving;          // the awake ones, advanced this step
+  std::vector<char> in_network;              // per moving body: predicted by the network
+  std::vector<int> networked;     // moving bodies that are scene.objects[0 … n), in order
+  std::vector<char> interacting;  // per scene object: has a collision edge
   std::unordered_map<const btCollisionObject*, int> scene_index;
   std::unordered_map<const btCollisionObject*, int> dynamic_index;  // into dynamic_bodies
+  std::unordered_map<const btCollisionObject*, int> moving_index;   // into moving
   std::vector<std::unique_ptr<TriangleMesh>> pieces;  // static-mesh triangles near bodies
   std::vector<std::shared_ptr<const TriangleMesh>> meshes;
   std::vector<ObjectPair> candidates;
   std::vector<std::pair<btCollisionObject*, btCollisionObject*>> pairs;
   std::vector<int> island;
   StepWorkspace workspace;
-  std::vector<Pose> next;
+  std::vector<Pose> network_next;  // per scene object
+  std::vector<Pose> next;          // per moving body
 
   int find(int i) {
     while (island[i] != i) i = island[i] = island[island[i]];
@@ -146,7 +155,7 @@ struct FIGNetDynamicsWorld::Impl {
       if (asleep[root] && !body->isActive()) {
         body->activate(true);
         states[body].valid = false;
-      } else if (!asleep[root] && ready[root] && body->isActive()) {
+      } else if (options.sleeping && !asleep[root] && ready[root] && body->isActive()) {
         body->setActivationState(ISLAND_SLEEPING);
         body->setLinearVelocity(btVector3(0, 0, 0));
         body->setAngularVelocity(btVector3(0, 0, 0));
@@ -189,8 +198,13 @@ struct FIGNetDynamicsWorld::Impl {
   // A static or kinematic partner of dynamic scene object `partner`: a floor candidate, a piece
   // of a static triangle mesh near the partner, or the whole body as a kinematic object.
   void add_obstacle(btCollisionObject& object, int partner, const btCollisionObject& dynamic) {
-    if (graph.floor != FloorModel::kNone && as_floor(object)) {
-      candidates.push_back({partner, -1});  // the floor's index is known once objects are
+    if (const std::optional<Floor> floor = as_floor(object);
+        floor && graph.floor != FloorModel::kNone) {
+      if (!scene.floor) scene.floor = floor;
+      if (!near_floor(dynamic, *floor)) return;
+      // A mesh floor is an object of the graph (its index is known once all objects are); an
+      // implicit one is in every node's features.
+      if (graph.floor == FloorModel::kMesh) candidates.push_back({partner, -1});
       return;
     }
     const StaticProperties properties{0.0, object.getFriction(), object.getRestitution()};
@@ -232,42 +246,81 @@ struct FIGNetDynamicsWorld::Impl {
     candidates.push_back({partner, found->second});
   }
 
+  // The awake dynamic bodies, their histories brought up to date.
+  void collect_moving() {
+    moving.clear();
+    moving_index.clear();
+    for (btRigidBody* body : dynamic_bodies) {
+      if (!body->isActive()) continue;
+      state_of(*body);
+      moving_index[body] = static_cast<int>(moving.size());
+      moving.push_back(body);
+    }
+  }
+
+  // Whether a moving body has a vertex within the collision radius of the floor plane: a static
+  // plane's broadphase box spans everything, so it pairs with every body.
+  bool near_floor(const btCollisionObject& body, const Floor& floor) const {
+    const BodyState& state = states.at(&body);
+    const Pose& pose = state.poses.back();
+    const Eigen::RowVector3d up = pose.orientation.toRotationMatrix().row(2);
+    const double lowest = pose.position.z() + (state.mesh->vertices() * up.transpose()).minCoeff();
+    return lowest - floor.height <= graph.collision_radius;
+  }
+
+  bool is_moving(const btCollisionObject* object) const {
+    return is_dynamic(object) && object->isActive();
+  }
+
+  // The scene the network sees: the moving bodies marked in `in_network`, the static and
+  // kinematic objects near them, and the object pairs to search for faces.
   void build_scene() {
     scene.objects.clear();
     scene.floor.reset();
-    simulated.clear();
+    networked.clear();
     scene_index.clear();
     pieces.clear();
     meshes.clear();
     candidates.clear();
-    for (btRigidBody* body : dynamic_bodies) {
-      if (!body->isActive()) continue;
-      BodyState& state = state_of(*body);
+    for (size_t i = 0; i < moving.size(); ++i) {
+      if (!in_network[i]) continue;
+      btRigidBody* body = moving[i];
       scene_index[body] =
-          add_object(*state.mesh, state.poses, std::nullopt,
+          add_object(*states[body].mesh, states[body].poses, std::nullopt,
                      {1.0 / body->getInvMass(), body->getFriction(), body->getRestitution()});
-      simulated.push_back(body);
+      networked.push_back(static_cast<int>(i));
     }
+    auto in_scene = [&](const btCollisionObject* object) {
+      return is_moving(object) && in_network[moving_index.at(object)];
+    };
     for (const auto& [a, b] : pairs) {
-      const bool a_moves = is_dynamic(a) && a->isActive(), b_moves = is_dynamic(b) && b->isActive();
-      if (a_moves && b_moves) {
+      const bool a_in = in_scene(a), b_in = in_scene(b);
+      if (a_in && b_in) {
         candidates.push_back(
             {std::min(scene_index[a], scene_index[b]), std::max(scene_index[a], scene_index[b])});
-      } else if (a_moves && !is_dynamic(b)) {
+      } else if (a_in && !is_dynamic(b)) {
         add_obstacle(*b, scene_index[a], *a);
-      } else if (b_moves && !is_dynamic(a)) {
+      } else if (b_in && !is_dynamic(a)) {
         add_obstacle(*a, scene_index[b], *b);
       }
     }
-    // The floor: the model's own floor object, paired where the broadphase says.
+    // The floor: the model's own floor object, paired where the broadphase says, and centred
+    // under its partners when one is far from the origin (the mesh spans ±floor_half_extent).
     const int floor_index = static_cast<int>(scene.objects.size());
+    Vec3 partners_sum = Vec3::Zero();
+    int partners = 0;
+    bool far = false;
     for (ObjectPair& pair : candidates) {
-      if (pair.b == -1) pair.b = floor_index;
+      if (pair.b != -1) continue;
+      pair.b = floor_index;
+      const Vec3 center = scene.objects[pair.a].centers.row(graph.history).transpose();
+      partners_sum += center;
+      ++partners;
+      far = far || center.head<2>().cwiseAbs().maxCoeff() > 0.5 * graph.floor_half_extent;
     }
-    for (const auto& [a, b] : pairs) {
-      for (const btCollisionObject* object : {a, b}) {
-        if (!scene.floor && graph.floor != FloorModel::kNone) scene.floor = as_floor(*object);
-      }
+    if (far) {
+      scene.floor->center_x = partners_sum.x() / partners;
+      scene.floor->center_y = partners_sum.y() / partners;
     }
     std::sort(candidates.begin(), candidates.end(), [](const ObjectPair& x, const ObjectPair& y) {
       return std::tie(x.a, x.b) < std::tie(y.a, y.b);
@@ -279,14 +332,83 @@ struct FIGNetDynamicsWorld::Impl {
                      candidates.end());
   }
 
+  // Which moving bodies the network predicts: all of them, or, with free flight, those with a
+  // collision edge (a body without any broadphase pair has none for certain; the others are
+  // searched as the graph builder will search them).
+  void choose_network_bodies() {
+    in_network.assign(moving.size(), options.free_flight ? 0 : 1);
+    if (options.free_flight) {
+      auto may_touch = [&](const btCollisionObject* body, const btCollisionObject* other) {
+        if (!is_moving(body)) return false;
+        if (is_moving(other)) return true;
+        if (is_dynamic(other)) return false;  // asleep
+        const std::optional<Floor> floor = as_floor(*other);
+        return !floor || graph.floor == FloorModel::kNone || near_floor(*body, *floor);
+      };
+      for (const auto& [a, b] : pairs) {
+        if (may_touch(a, b)) in_network[moving_index.at(a)] = 1;
+        if (may_touch(b, a)) in_network[moving_index.at(b)] = 1;
+      }
+    }
+    build_scene();
+    if (!options.free_flight || networked.empty()) return;
+    contact_query->find_interacting_objects(scene, candidates, interacting);
+    bool all_interact = true;
+    for (size_t k = 0; k < networked.size(); ++k) {
+      if (interacting[k]) continue;
+      in_network[networked[k]] = 0;
+      all_interact = false;
+    }
+    if (!all_interact) build_scene();
+  }
+
+  // Free flight: x_{t+1} = 2x_t − x_{t−1} + g·dt², exact for constant acceleration (applied
+  // forces are already in the history's last velocity), and the last step's rotation again.
+  Pose free_flight_pose(const btRigidBody& body) const {
+    const std::vector<Pose>& poses = states.at(&body).poses;
+    const Pose& current = poses.back();
+    const Vec3 g = from_bt(body.getGravity());
+    Pose next;
+    if (poses.size() < 2) {  // no history: Bullet's velocities
+      next.position = current.position + time_step * from_bt(body.getLinearVelocity()) +
+                      time_step * time_step * g;
+      const Vec3 turn = time_step * from_bt(body.getAngularVelocity());
+      next.orientation =
+          turn.norm() > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(turn.norm(), turn.normalized())) *
+                                current.orientation
+                          : current.orientation;
+    } else {
+      const Pose& previous = poses[poses.size() - 2];
+      next.position = 2.0 * current.position - previous.position + time_step * time_step * g;
+      next.orientation =
+          current.orientation * previous.orientation.conjugate() * current.orientation;
+    }
+    next.orientation.normalize();
+    return next;
+  }
+
+  // Next poses of every moving body: the network's for the bodies in contact, free flight for
+  // the others.
+  void advance() {
+    next.resize(moving.size());
+    if (!networked.empty()) {
+      predictor->predict_with_candidates(scene, candidates, workspace.accelerations);
+      integrate_next_poses(scene, network_next, workspace);
+      for (size_t k = 0; k < networked.size(); ++k) next[networked[k]] = network_next[k];
+    }
+    for (size_t i = 0; i < moving.size(); ++i) {
+      if (!in_network[i]) next[i] = free_flight_pose(*moving[i]);
+    }
+  }
+
   // The tunnelling guard. A step longer than the collision radius can carry a body past a surface
   // that was never within the graph's reach; such a step is swept with the body's convex shape
   // (or, for compounds, a sphere inside it) and, if it would cross a surface it moves against,
   // the body stops where it touches, as Bullet's CCD stops a body.
   void guard_fast_bodies(btCollisionWorld& world) {
     if (!options.sweep_guard) return;
-    for (size_t i = 0; i < simulated.size(); ++i) {
-      btRigidBody& body = *simulated[i];
+    for (size_t i = 0; i < moving.size(); ++i) {
+      btRigidBody& body = *moving[i];
       const Pose& current = states[&body].poses.back();
       Pose& next_pose = next[i];
       const Vec3 motion = next_pose.position - current.position;
@@ -338,10 +460,75 @@ struct FIGNetDynamicsWorld::Impl {
     const btCollisionObject* self_;
   };
 
-  // New poses, velocities and interpolation state of the simulated bodies.
+  // The deepest penetration of one body into static geometry, from Bullet's narrow phase.
+  struct StaticPenetration : btCollisionWorld::ContactResultCallback {
+    explicit StaticPenetration(const btCollisionObject* self) : self_(self) {
+      m_collisionFilterGroup = self->getBroadphaseHandle()->m_collisionFilterGroup;
+      m_collisionFilterMask = self->getBroadphaseHandle()->m_collisionFilterMask;
+    }
+    bool needsCollision(btBroadphaseProxy* proxy) const override {
+      const auto* other = static_cast<const btCollisionObject*>(proxy->m_clientObject);
+      return ContactResultCallback::needsCollision(proxy) && other != self_ &&
+             other->isStaticObject() && other->hasContactResponse();
+    }
+    btScalar addSingleResult(btManifoldPoint& point, const btCollisionObjectWrapper* first, int,
+                             int, const btCollisionObjectWrapper*, int, int) override {
+      const double penetration = -point.getDistance();
+      if (penetration <= depth) return 0;
+      // The normal points from the second object to the first: out of the static one when the
+      // body is first.
+      const Vec3 normal = from_bt(point.m_normalWorldOnB);
+      out = first->getCollisionObject() == self_ ? normal : Vec3(-normal);
+      depth = penetration;
+      return 0;
+    }
+    const btCollisionObject* self_;
+    double depth = 0.0;
+    Vec3 out = Vec3::Zero();
+  };
+
+  // The penetration guard (after write_back): a body deeper than the tolerance in static
+  // geometry moves out along the contact normal, history included, so the network does not see
+  // the correction as velocity; the inward part of its velocity goes. A few passes let a body
+  // wedged against two surfaces leave both.
+  void recover_static_penetrations(btCollisionWorld& world) {
+    if (!options.penetration_guard) return;
+    for (btRigidBody* body : moving) {
+      BodyState& state = states[body];
+      bool moved = false;
+      for (int pass = 0; pass < 4; ++pass) {
+        StaticPenetration contact(body);
+        world.contactTest(body, contact);
+        if (contact.depth <= options.penetration_tolerance) break;
+        const Vec3 push = contact.depth * contact.out;
+        for (Pose& pose : state.poses) pose.position += push;
+        // v' = v − min(0, v·n)·n; the previous poses shift to match it.
+        const size_t h = state.poses.size() - 1;
+        if (h > 0) {
+          const Vec3 velocity = (state.poses[h].position - state.poses[h - 1].position) / time_step;
+          const double inward = velocity.dot(contact.out);
+          if (inward < 0) {
+            for (size_t k = 0; k < h; ++k)
+              state.poses[k].position += inward * time_step * contact.out;
+          }
+        }
+        Vec3 velocity = from_bt(body->getLinearVelocity());
+        velocity -= std::min(0.0, velocity.dot(contact.out)) * contact.out;
+        body->setLinearVelocity(to_bt(velocity));
+        body->proceedToTransform(to_bt(state.poses.back()));
+        moved = true;
+      }
+      if (!moved) continue;
+      ++stats.recovered_bodies;
+      state.written = body->getWorldTransform();
+      state.written_linear = body->getLinearVelocity();
+    }
+  }
+
+  // New poses, velocities and interpolation state of the moving bodies.
   void write_back() {
-    for (size_t i = 0; i < simulated.size(); ++i) {
-      btRigidBody& body = *simulated[i];
+    for (size_t i = 0; i < moving.size(); ++i) {
+      btRigidBody& body = *moving[i];
       BodyState& state = states[&body];
       const Pose& current = state.poses.back();
       const Pose& next_pose = next[i];
@@ -381,6 +568,7 @@ struct FIGNetDynamicsWorld::Impl {
 
   void record_face_lines() {
     face_lines.clear();
+    if (networked.empty()) return;
     const auto* model = dynamic_cast<const ModelPredictor*>(predictor.get());
     if (!model) return;
     for (const FacePair& pair : model->builder().face_pairs())
@@ -421,6 +609,12 @@ FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
   impl_->graph = graph;
   impl_->time_step = time_step;
   impl_->gravity = gravity;
+  impl_->contact_query.emplace(graph);
+  if (options.penetration_tolerance < 0 || !std::isfinite(options.penetration_tolerance)) {
+    throw ConfigError(fmt::format(
+        "FIGNetDynamicsWorld: penetration_tolerance is {} m; it must be finite and >= 0",
+        options.penetration_tolerance));
+  }
   setGravity(to_bt(gravity));
 }
 
@@ -459,6 +653,15 @@ void FIGNetDynamicsWorld::set_shape_mesh(const btCollisionShape& shape,
 
 const FIGNetStepStats& FIGNetDynamicsWorld::last_step_stats() const {
   return impl_->stats;
+}
+
+Pose FIGNetDynamicsWorld::precise_pose(const btCollisionObject& object) const {
+  const auto state = impl_->states.find(&object);
+  if (state != impl_->states.end() && state->second.valid && !state->second.poses.empty() &&
+      object.getWorldTransform() == state->second.written) {
+    return state->second.poses.back();
+  }
+  return from_bt(object.getWorldTransform());
 }
 
 void FIGNetDynamicsWorld::removeRigidBody(btRigidBody* body) {
@@ -536,29 +739,28 @@ void FIGNetDynamicsWorld::internalSingleStepSimulation(btScalar time_step) {
   updateAabbs();
   computeOverlappingPairs();
   impl.collect_pairs_and_islands(*this);
-  impl.build_scene();
+  impl.collect_moving();
+  impl.choose_network_bodies();
   impl.stats.prepare_seconds = seconds_since(start);
 
   const auto predict_start = Clock::now();
-  if (!impl.simulated.empty()) {
-    impl.predictor->predict_with_candidates(impl.scene, impl.candidates,
-                                            impl.workspace.accelerations);
-    integrate_next_poses(impl.scene, impl.next, impl.workspace);
-    impl.guard_fast_bodies(*this);
-  }
+  impl.advance();
+  impl.guard_fast_bodies(*this);
   impl.stats.predict_seconds = seconds_since(predict_start);
 
   const auto write_start = Clock::now();
   impl.write_back();
+  impl.recover_static_penetrations(*this);
   impl.record_kinematic_poses(*this);
   impl.record_face_lines();
   impl.stats.write_back_seconds = seconds_since(write_start);
-  impl.stats.simulated_bodies = static_cast<int>(impl.simulated.size());
-  impl.stats.sleeping_bodies = static_cast<int>(impl.dynamic_bodies.size() - impl.simulated.size());
-  impl.stats.kinematic_objects =
-      static_cast<int>(impl.scene.objects.size() - impl.simulated.size());
+  const int networked = static_cast<int>(impl.networked.size());
+  impl.stats.simulated_bodies = networked;
+  impl.stats.free_flight_bodies = static_cast<int>(impl.moving.size()) - networked;
+  impl.stats.sleeping_bodies = static_cast<int>(impl.dynamic_bodies.size() - impl.moving.size());
+  impl.stats.kinematic_objects = static_cast<int>(impl.scene.objects.size()) - networked;
   impl.stats.candidate_pairs = static_cast<int>(impl.candidates.size());
-  impl.stats.face_edges = impl.predictor->last_face_edges();
+  impl.stats.face_edges = networked > 0 ? impl.predictor->last_face_edges() : 0;
   if (m_internalTickCallback) (*m_internalTickCallback)(this, time_step);
 }
 

@@ -172,11 +172,16 @@ std::vector<Simulator> stress_simulators(
     SolverSettings one_step;
     one_step.steps_per_frame = 1;
     std::shared_ptr<const Model> shared = model;
-    sims.push_back({fmt::format("FIGNet {}", name), one_step,
-                    [shared](btDispatcher* d, btBroadphaseInterface* b, btConstraintSolver* s,
-                             btCollisionConfiguration* c) {
-                      return std::make_unique<FIGNetDynamicsWorld>(d, b, s, c, shared);
-                    }});
+    // The network alone (what the model itself does), then the world as users get it.
+    for (const bool alone : {true, false}) {
+      const FIGNetWorldOptions options =
+          alone ? FIGNetWorldOptions::network_alone() : FIGNetWorldOptions{};
+      sims.push_back({fmt::format("FIGNet {}{}", name, alone ? " (network alone)" : ""), one_step,
+                      [shared, options](btDispatcher* d, btBroadphaseInterface* b,
+                                        btConstraintSolver* s, btCollisionConfiguration* c) {
+                        return std::make_unique<FIGNetDynamicsWorld>(d, b, s, c, shared, options);
+                      }});
+    }
   }
   return sims;
 }

@@ -1,6 +1,7 @@
 // FIGNetDynamicsWorld against native Bullet on the same scenes, in the same run: the whole step
 // with a model, the world's own cost with a network-free predictor (conversion, broadphase, face
-// pairs, write-back), and a few bodies on a large static triangle mesh.
+// pairs, write-back), a few bodies on a large static triangle mesh, and a few bodies in contact
+// among many in free flight or asleep.
 //
 //   build/release/tests/bench/bench_world
 #include <benchmark/benchmark.h>
@@ -140,6 +141,76 @@ BENCHMARK(FIGNetWorldOnALargeStaticMesh)
     ->Arg(10)
     ->Arg(100)
     ->Arg(400)
+    ->Unit(benchmark::kMicrosecond);
+
+// Cost follows contact, not scene size: `in_contact` boxes resting just above the floor (the
+// network's work) among `total` bodies whose others are in free flight high above it or asleep
+// on it, far apart. Every iteration puts the moving bodies back, so each step sees the same
+// contacts. Model: the small preset, untrained (the cost does not depend on the weights).
+void FIGNetWorldMostlyIdle(benchmark::State& state, bool others_asleep) {
+  const int total = static_cast<int>(state.range(0));
+  const int in_contact = static_cast<int>(state.range(1));
+  btDefaultCollisionConfiguration configuration;
+  btCollisionDispatcher dispatcher(&configuration);
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  auto model = std::make_shared<const Model>(ModelConfig::preset_named("small"));
+  FIGNetDynamicsWorld world(&dispatcher, &broadphase, &solver, &configuration,
+                            std::make_unique<ModelPredictor>(model), model->config().graph,
+                            1.0 / 48.0, Vec3(0, 0, -10));
+  btStaticPlaneShape plane(btVector3(0, 0, 1), 0);
+  btRigidBody floor(0, nullptr, &plane);
+  world.addRigidBody(&floor);
+  btBoxShape box(btVector3(0.2f, 0.2f, 0.2f));
+  btVector3 inertia;
+  box.calculateLocalInertia(1, inertia);
+  std::vector<std::unique_ptr<btRigidBody>> bodies;
+  std::vector<btTransform> starts;
+  const int side = static_cast<int>(std::ceil(std::sqrt(total)));
+  for (int i = 0; i < total; ++i) {
+    const bool contact = i < in_contact;
+    const btVector3 grid(3.0f * (i % side) + 20, 3.0f * (i / side) + 20, 0);
+    // Contact bodies 1 m apart near the origin: the model's floor mesh spans ±40 m.
+    const int row = static_cast<int>(std::ceil(std::sqrt(in_contact)));
+    const btVector3 start = contact ? btVector3(1.0f * (i % row) - 15, 1.0f * (i / row) - 15, 0.21f)
+                            : others_asleep ? grid + btVector3(0, 0, 0.2f)
+                                            : grid + btVector3(0, 0, 50);
+    bodies.push_back(std::make_unique<btRigidBody>(1, nullptr, &box, inertia));
+    starts.emplace_back(btQuaternion::getIdentity(), start);
+    bodies.back()->setWorldTransform(starts.back());
+    world.addRigidBody(bodies.back().get());
+    // Put back at rest every step, the moving bodies would fall asleep after Bullet's 2 s.
+    bodies.back()->setActivationState(!contact && others_asleep ? ISLAND_SLEEPING
+                                                                : DISABLE_DEACTIVATION);
+  }
+  for (auto _ : state) {
+    for (int i = 0; i < total; ++i) {
+      if (!bodies[i]->isActive()) continue;
+      bodies[i]->setWorldTransform(starts[i]);
+      bodies[i]->setLinearVelocity(btVector3(0, 0, 0));
+      bodies[i]->setAngularVelocity(btVector3(0, 0, 0));
+    }
+    world.stepSimulation(1.0f / 48.0f, 1, 1.0f / 48.0f);
+  }
+  const FIGNetStepStats& stats = world.last_step_stats();
+  state.counters["network_bodies"] = stats.simulated_bodies;
+  state.counters["free_flight"] = stats.free_flight_bodies;
+  state.counters["asleep"] = stats.sleeping_bodies;
+  state.counters["face_edges"] = stats.face_edges;
+  state.counters["pairs"] = stats.candidate_pairs;
+  for (auto& body : bodies) world.removeRigidBody(body.get());
+  world.removeRigidBody(&floor);
+}
+BENCHMARK_CAPTURE(FIGNetWorldMostlyIdle, others_in_free_flight, false)
+    ->Args({10, 10})
+    ->Args({100, 10})
+    ->Args({1000, 10})
+    ->Args({100, 100})
+    ->Args({1000, 1000})
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(FIGNetWorldMostlyIdle, others_asleep, true)
+    ->Args({100, 10})
+    ->Args({1000, 10})
     ->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <set>
 
 #include "fignet/bullet/bullet_simulation.h"
@@ -16,6 +18,7 @@
 namespace fignet::bullet {
 namespace {
 
+using testing::network_alone;
 using testing::recording_predictor;
 using testing::WorldFixture;
 
@@ -27,29 +30,53 @@ Pose at(const Vec3& position,
   return pose;
 }
 
-TEST(FIGNetWorld, ExactGravityGivesBallisticMotionAndConsistentState) {
-  WorldFixture fixture(recording_predictor());
-  // Without Bullet's one-step latency, motion states show the step's own result.
-  fixture.world.setLatencyMotionStateInterpolation(false);
-  btRigidBody* box = fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.3f, 0.4f)), 2.0,
-                                 at(Vec3(0, 0, 50)));
-  const Vec3 v0(1.0, -2.0, 3.0);
-  box->setLinearVelocity(to_bt(v0));
-  const double dt = WorldFixture::kStep;
-  const Vec3 g(0, 0, -10);
-  for (int n = 1; n <= 48; ++n) {
-    fixture.step();
-    // x_{n+1} = 2x_n − x_{n−1} + g·dt² from a constant-velocity history:
-    // x_n = x_0 + n·dt·v0 + n(n+1)/2·g·dt², v_n = v0 + n·g·dt.
-    const Vec3 expected = Vec3(0, 0, 50) + n * dt * v0 + 0.5 * n * (n + 1) * dt * dt * g;
-    const Vec3 position = from_bt(box->getCenterOfMassPosition());
-    ASSERT_LT((position - expected).norm(), 2e-4 * (1 + n)) << "step " << n;
-    EXPECT_LT((from_bt(box->getLinearVelocity()) - (v0 + n * dt * g)).norm(), 1e-3);
-    btTransform motion;
-    box->getMotionState()->getWorldTransform(motion);
-    EXPECT_LT((motion.getOrigin() - box->getWorldTransform().getOrigin()).length(), 1e-5);
+// Free flight, by the world's own path and by an exact-gravity predictor through the network's
+// path: both follow x_{n+1} = 2x_n − x_{n−1} + g·dt² from a constant-velocity history, so
+// x_n = x_0 + n·dt·v0 + n(n+1)/2·g·dt² and v_n = v0 + n·g·dt (Bullet's semi-implicit Euler).
+TEST(FIGNetWorld, FreeFlightFollowsTheAnalyticTrajectory) {
+  for (const bool free_flight : {true, false}) {
+    SCOPED_TRACE(free_flight ? "free-flight path" : "through the predictor");
+    FIGNetWorldOptions options = network_alone();
+    options.free_flight = free_flight;
+    auto predictor = recording_predictor();
+    const auto* recorder = predictor.get();
+    WorldFixture fixture(std::move(predictor), {}, options);
+    // Without Bullet's one-step latency, motion states show the step's own result.
+    fixture.world.setLatencyMotionStateInterpolation(false);
+    btRigidBody* box = fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.3f, 0.4f)), 2.0,
+                                   at(Vec3(0, 0, 50)));
+    const Vec3 v0(1.0, -2.0, 3.0), w0(0.5, -1.0, 2.0);
+    box->setLinearVelocity(to_bt(v0));
+    box->setAngularVelocity(to_bt(w0));
+    const double dt = WorldFixture::kStep;
+    const Vec3 g(0, 0, -10);
+    double worst_precise = 0;
+    for (int n = 1; n <= 48; ++n) {
+      fixture.step();
+      const Vec3 expected = Vec3(0, 0, 50) + n * dt * v0 + 0.5 * n * (n + 1) * dt * dt * g;
+      const Vec3 position = from_bt(box->getCenterOfMassPosition());
+      ASSERT_LT((position - expected).norm(), 2e-4 * (1 + n)) << "step " << n;
+      worst_precise =
+          std::max(worst_precise, (fixture.world.precise_pose(*box).position - expected).norm());
+      EXPECT_LT((from_bt(box->getLinearVelocity()) - (v0 + n * dt * g)).norm(), 1e-3);
+      btTransform motion;
+      box->getMotionState()->getWorldTransform(motion);
+      EXPECT_LT((motion.getOrigin() - box->getWorldTransform().getOrigin()).length(), 1e-5);
+    }
+    // The world's own path is exact in double precision; the predictor's goes through vertex
+    // accelerations and a rigid fit.
+    if (free_flight) {
+      EXPECT_LT(worst_precise, 1e-9);
+      // Constant angular velocity: 48 steps turn the box by 48·dt·|ω| about ω.
+      const Eigen::AngleAxisd turned(fixture.world.precise_pose(*box).orientation);
+      EXPECT_NEAR(turned.angle(), 48 * dt * w0.norm(), 1e-9);
+      EXPECT_LT((turned.axis() - w0.normalized()).norm(), 1e-9);
+      EXPECT_EQ(recorder->calls, 0);
+    }
+    const FIGNetStepStats& stats = fixture.world.last_step_stats();
+    EXPECT_EQ(stats.simulated_bodies, free_flight ? 0 : 1);
+    EXPECT_EQ(stats.free_flight_bodies, free_flight ? 1 : 0);
   }
-  EXPECT_EQ(fixture.world.last_step_stats().simulated_bodies, 1);
 }
 
 TEST(FIGNetWorld, AKinematicBodyFollowsItsMotionStateExactly) {
@@ -171,7 +198,7 @@ TEST(ShapeMeshes, UnsupportedShapesNameThemselves) {
 TEST(FIGNetWorld, ShapeMeshesCanBeGivenAndMustFitTheShape) {
   auto predictor = recording_predictor();
   testing::RecordingPredictor& recorder = *predictor;
-  WorldFixture fixture(std::move(predictor));
+  WorldFixture fixture(std::move(predictor), {}, network_alone());
   auto shape = std::make_unique<btBoxShape>(btVector3(0.5, 0.5, 0.5));
   const btCollisionShape& box = *shape;
   Pose pose;
@@ -194,6 +221,7 @@ TEST(FIGNetWorld, TheSweepGuardStopsTunnellingThroughTheFloor) {
   for (bool guard : {true, false}) {
     FIGNetWorldOptions options;
     options.sweep_guard = guard;
+    options.penetration_guard = false;
     WorldFixture fixture(recording_predictor(), {}, options);
     fixture.add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0, Pose{});
     Pose start;
@@ -234,7 +262,7 @@ TEST(FIGNetWorld, RejectsAnotherTimeStepOrGravity) {
 TEST(FIGNetWorld, BodiesComeAndGoMidRunAndVelocityChangesReseedHistory) {
   auto predictor = recording_predictor();
   auto* recorder = predictor.get();
-  WorldFixture fixture(std::move(predictor));
+  WorldFixture fixture(std::move(predictor), {}, network_alone());
   btRigidBody* first = fixture.add(std::make_unique<btSphereShape>(0.1f), 1.0, at(Vec3(0, 0, 5)));
   fixture.step(3);
   btRigidBody* second = fixture.add(std::make_unique<btSphereShape>(0.1f), 1.0, at(Vec3(3, 0, 5)));
@@ -262,8 +290,10 @@ TEST(FIGNetWorld, RestingBodiesSleepAndWakeWhenTouched) {
   };
   auto predictor = std::make_unique<Still>();
   auto* recorder = predictor.get();
-  GraphConfig graph;
-  WorldFixture fixture(std::move(predictor), graph, {true, true, true});
+  FIGNetWorldOptions options = network_alone();
+  options.allow_gravity_mismatch = true;
+  options.sleeping = true;
+  WorldFixture fixture(std::move(predictor), {}, options);
   btRigidBody* resting = fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0,
                                      at(Vec3(0, 0, 0.2)));
   btRigidBody* far = fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0,
@@ -284,7 +314,7 @@ TEST(FIGNetWorld, RestingBodiesSleepAndWakeWhenTouched) {
 TEST(FIGNetWorld, CollisionFilteringKeepsFilteredPairsOutOfTheGraph) {
   auto predictor = recording_predictor();
   auto* recorder = predictor.get();
-  WorldFixture fixture(std::move(predictor));
+  WorldFixture fixture(std::move(predictor), {}, network_alone());
   const int group_a = 2, group_b = 4;
   auto add_box = [&](const Vec3& p, int group, int mask) {
     auto shape = std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f));
@@ -336,10 +366,9 @@ TEST(FIGNetWorld, ARealModelStepsAMoviASceneWithoutNaNAsEvalRolloutsDo) {
   BulletSimulation simulation(spec, settings,
                               [&](btDispatcher* d, btBroadphaseInterface* b, btConstraintSolver* s,
                                   btCollisionConfiguration* c) {
-                                // The tunnelling guard is the world's one addition to the
-                                // learned step (on steps longer than d_c that would cross a
-                                // surface); core rollouts have no Bullet to sweep against.
-                                FIGNetWorldOptions options;
+                                // The network alone, as core rollouts run it: none of the
+                                // world's additions (the guards, free flight, sleeping).
+                                FIGNetWorldOptions options = network_alone();
                                 options.sweep_guard = false;
                                 return std::make_unique<FIGNetDynamicsWorld>(d, b, s, c, model,
                                                                              options);
@@ -371,6 +400,177 @@ TEST(FIGNetWorld, ARealModelStepsAMoviASceneWithoutNaNAsEvalRolloutsDo) {
       ASSERT_LT(a.orientation.angularDistance(b.orientation), 1e-4)
           << "object " << o << " frame " << f;
     }
+  }
+}
+
+}  // namespace
+}  // namespace fignet::bullet
+
+namespace fignet::bullet {
+namespace {
+
+using testing::network_alone;
+using testing::WorldFixture;
+
+// A model that always answers "fall": every node accelerates by 3 g, contact or not.
+class AlwaysFalls : public GravityPredictor {
+ public:
+  AlwaysFalls() : GravityPredictor(Vec3(0, 0, -30), WorldFixture::kStep) {}
+};
+
+// The lowest point of a box body: its corners.
+double lowest_corner(const btRigidBody& body, const btVector3& half) {
+  double lowest = INFINITY;
+  for (int corner = 0; corner < 8; ++corner) {
+    const btVector3 local((corner & 1 ? 1 : -1) * half.x(), (corner & 2 ? 1 : -1) * half.y(),
+                          (corner & 4 ? 1 : -1) * half.z());
+    lowest = std::min(lowest, double((body.getWorldTransform() * local).z()));
+  }
+  return lowest;
+}
+
+// Whatever the model says, no body sinks into static geometry deeper than the tolerance: on a
+// static plane, a static triangle mesh and a static box; without the guard, it sinks.
+TEST(FIGNetWorld, ThePenetrationGuardHoldsAFallingModelOnStaticGeometry) {
+  btTriangleMesh terrain;
+  terrain.addTriangle(btVector3(-5, -5, 0), btVector3(5, -5, 0), btVector3(5, 5, 0));
+  terrain.addTriangle(btVector3(-5, -5, 0), btVector3(5, 5, 0), btVector3(-5, 5, 0));
+  for (const std::string surface : {"plane", "triangle mesh", "box"}) {
+    for (const bool guard : {true, false}) {
+      SCOPED_TRACE(surface + (guard ? " with the guard" : " without"));
+      FIGNetWorldOptions options;
+      options.penetration_guard = guard;
+      options.allow_gravity_mismatch = true;
+      WorldFixture fixture(std::make_unique<AlwaysFalls>(), {}, options);
+      if (surface == "plane") {
+        fixture.add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0, Pose{});
+      } else if (surface == "triangle mesh") {
+        fixture.add(std::make_unique<btBvhTriangleMeshShape>(&terrain, true), 0.0, Pose{});
+      } else {
+        fixture.add(std::make_unique<btBoxShape>(btVector3(5, 5, 1)), 0.0, at(Vec3(0, 0, -1)));
+      }
+      const btVector3 half(0.2f, 0.3f, 0.25f);
+      btRigidBody* box =
+          fixture.add(std::make_unique<btBoxShape>(half), 1.0,
+                      at(Vec3(0.5, -0.3, 1.0),
+                         Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Vec3(1, 1, 0).normalized()))));
+      box->setActivationState(DISABLE_DEACTIVATION);
+      // Bullet rounds a box's corners by its margin against meshes and boxes (GJK); depths are
+      // measured on that shape, so a corner may sit up to the margin deeper.
+      const double margin = 0.004;
+      box->getCollisionShape()->setMargin(btScalar(margin));
+      double lowest = INFINITY;
+      int recovered = 0;
+      for (int step = 0; step < 200; ++step) {
+        fixture.step();
+        lowest = std::min(lowest, lowest_corner(*box, half));
+        recovered += fixture.world.last_step_stats().recovered_bodies;
+      }
+      if (guard) {
+        EXPECT_GT(lowest, -options.penetration_tolerance - margin);
+        EXPECT_GT(recovered, 100);  // it is pushed out almost every step
+        // Its inward velocity goes each time: it never gains downward speed.
+        EXPECT_GT(box->getLinearVelocity().z(), -30 * WorldFixture::kStep - 1e-3);
+      } else {
+        EXPECT_LT(lowest, -1.0);
+        EXPECT_EQ(recovered, 0);
+      }
+    }
+  }
+}
+
+// A small untrained model (its answers are arbitrary but deterministic) on boxes `clearance`
+// above a static plane.
+struct ModelScene {
+  explicit ModelScene(const FIGNetWorldOptions& options)
+      : model(make_model()),
+        fixture(std::make_unique<ModelPredictor>(model), model->config().graph, options) {
+    fixture.add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0, Pose{});
+  }
+  static std::shared_ptr<const Model> make_model() {
+    ModelConfig config = ModelConfig::preset_named("small");
+    config.latent_size = 16;
+    config.message_passing_steps = 2;
+    return std::make_shared<const Model>(config);
+  }
+  btRigidBody* add_box(const Vec3& centre) {
+    return fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0, at(centre));
+  }
+  std::shared_ptr<const Model> model;
+  WorldFixture fixture;
+};
+
+// The free-flight path changes nothing for bodies in contact: their graph and the network's
+// answer for them do not depend on bodies they have no edge to. With every body in contact the
+// two runs are the same; a body far up is left out of the network and falls exactly.
+TEST(FIGNetWorld, FreeFlightLeavesBodiesInContactAsTheNetworkMovesThem) {
+  std::vector<std::vector<Pose>> runs[2];
+  for (const bool with_flyer : {false, true}) {
+    for (const bool free_flight : {false, true}) {
+      SCOPED_TRACE(fmt::format("flyer {}, free flight {}", with_flyer, free_flight));
+      FIGNetWorldOptions options = network_alone();
+      options.free_flight = free_flight;
+      ModelScene scene(options);
+      std::vector<btRigidBody*> resting;
+      for (int i = 0; i < 3; ++i) resting.push_back(scene.add_box(Vec3(1.0 * i, 0.3 * i, 0.25)));
+      resting.push_back(scene.add_box(Vec3(0.0, 0.0, 0.7)));  // on the first: a stack
+      btRigidBody* flyer = with_flyer ? scene.add_box(Vec3(10, 10, 30)) : nullptr;
+      std::vector<Pose> poses;
+      for (int step = 0; step < 6; ++step) {
+        scene.fixture.step();
+        for (btRigidBody* body : resting) poses.push_back(scene.fixture.world.precise_pose(*body));
+        const FIGNetStepStats& stats = scene.fixture.world.last_step_stats();
+        ASSERT_EQ(stats.simulated_bodies, free_flight ? 4 : 4 + with_flyer);
+        ASSERT_EQ(stats.free_flight_bodies, free_flight ? with_flyer : 0);
+      }
+      if (flyer && free_flight) {
+        const double n = 6, dt = WorldFixture::kStep;
+        EXPECT_NEAR(scene.fixture.world.precise_pose(*flyer).position.z(),
+                    30 - 0.5 * n * (n + 1) * dt * dt * 10, 1e-9);
+      }
+      runs[with_flyer].push_back(poses);
+    }
+  }
+  for (const auto& pair : runs) {
+    ASSERT_EQ(pair.size(), 2u);
+    for (size_t k = 0; k < pair[0].size(); ++k) {
+      // Bit for bit without the flyer; with it, the network's products see more rows, which
+      // may change float rounding.
+      EXPECT_LT((pair[0][k].position - pair[1][k].position).norm(), 1e-6) << "pose " << k;
+      EXPECT_LT(pair[0][k].orientation.angularDistance(pair[1][k].orientation), 1e-6);
+    }
+  }
+  EXPECT_EQ(runs[0][0][5].position, runs[0][1][5].position);
+}
+
+}  // namespace
+}  // namespace fignet::bullet
+
+namespace fignet::bullet {
+namespace {
+
+// The model's floor mesh spans ±40 m; a body resting 1 km from the origin still meets it, centred
+// under it, and goes through the network; near the origin the floor stays where training had it.
+TEST(FIGNetWorld, ABodyFarFromTheOriginStillMeetsTheFloor) {
+  for (const double x : {1000.0, 3.0}) {
+    auto predictor = testing::recording_predictor();
+    auto* recorder = predictor.get();
+    testing::WorldFixture fixture(std::move(predictor));
+    fixture.add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0, Pose{});
+    Pose pose;
+    pose.position = Vec3(x, 0, 0.25);
+    fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0, pose);
+    // A body high up and far away pairs with the plane too (its box spans everything), but
+    // neither enters the graph nor moves the floor.
+    pose.position = Vec3(-x, 500, 50);
+    fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0, pose);
+    fixture.step();
+    EXPECT_EQ(fixture.world.last_step_stats().simulated_bodies, 1) << x;
+    EXPECT_EQ(fixture.world.last_step_stats().free_flight_bodies, 1) << x;
+    ASSERT_TRUE(recorder->last_scene.floor.has_value());
+    EXPECT_NEAR(recorder->last_scene.floor->center_x, x > 100 ? x : 0.0, 1e-3);
+    ASSERT_EQ(recorder->last_candidates.size(), 1u);
+    EXPECT_EQ(recorder->last_candidates[0].b, 1);  // the floor, after the body
   }
 }
 

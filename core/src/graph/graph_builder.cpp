@@ -75,15 +75,79 @@ const SceneObject& GraphBuilder::floor_object(const Scene& scene, int scene_inde
   floor.properties = scene.floor->properties;
   floor.positions.resize(steps * v, 3);
   floor.centers.resize(steps, 3);
-  Points lifted = floor_mesh_.vertices();
-  lifted.col(2).array() += scene.floor->height;
+  const Vec3 center(scene.floor->center_x, scene.floor->center_y, scene.floor->height);
+  const Points lifted = floor_mesh_.vertices().rowwise() + center.transpose();
   for (int k = 0; k < steps; ++k) {
     floor.positions.middleRows(k * v, v) = lifted;
-    floor.centers.row(k) << 0.0, 0.0, scene.floor->height;
+    floor.centers.row(k) = center.transpose();
   }
   floor.next_positions = lifted;
-  floor.next_center = Vec3(0.0, 0.0, scene.floor->height);
+  floor.next_center = center;
   return floor;
+}
+
+void GraphBuilder::gather_objects(const Scene& scene, int scene_index) {
+  validate_scene(scene, scene_index);
+  objects_.clear();
+  for (const SceneObject& object : scene.objects) objects_.push_back(&object);
+  if (config_.floor == FloorModel::kMesh && scene.floor) {
+    objects_.push_back(&floor_object(scene, scene_index));
+  }
+}
+
+PosedMesh GraphBuilder::current_pose(const SceneObject& object) const {
+  const size_t current_row = static_cast<size_t>(config_.history) * object.mesh->num_vertices();
+  return {object.mesh, object.positions.data() + current_row * 3, object.kinematic};
+}
+
+void GraphBuilder::select_pairs(const std::span<const ObjectPair>* candidates) {
+  if (!candidates) {
+    contacts_.find_candidate_pairs(config_.collision_radius, pairs_);
+    return;
+  }
+  pairs_.clear();
+  const int n = static_cast<int>(objects_.size());
+  for (const ObjectPair& pair : *candidates) {
+    if (pair.a < 0 || pair.b < 0 || pair.a >= n || pair.b >= n || pair.a == pair.b) {
+      throw ConfigError(fmt::format(
+          "candidate pair ({}, {}) is not a pair of the scene's {} objects", pair.a, pair.b, n));
+    }
+    // Neither of two kinematic objects is predicted: their contact carries no information.
+    if (posed_[pair.a].kinematic && posed_[pair.b].kinematic) continue;
+    pairs_.push_back({std::min(pair.a, pair.b), std::max(pair.a, pair.b)});
+  }
+}
+
+void GraphBuilder::find_interacting_objects(const Scene& scene,
+                                            std::span<const ObjectPair> candidates,
+                                            std::vector<char>& interacting) {
+  gather_objects(scene, 0);
+  posed_.clear();
+  for (const SceneObject* object : objects_) posed_.push_back(current_pose(*object));
+  const bool face_collisions = config_.collisions == CollisionEdges::kFaceFace;
+  contacts_.update(posed_, !face_collisions);
+  select_pairs(&candidates);
+  interacting.assign(objects_.size(), 0);
+  // The same search build() makes: a collision edge marks both of its objects.
+  if (face_collisions) {
+    contacts_.find_face_pairs(pairs_, config_.collision_radius, scene_face_pairs_);
+    for (const FacePair& pair : scene_face_pairs_) {
+      interacting[pair.object_a] = interacting[pair.object_b] = 1;
+    }
+  } else {
+    contacts_.find_node_pairs(pairs_, config_.collision_radius, node_pairs_);
+    for (const NodePair& pair : node_pairs_) {
+      interacting[pair.object_a] = interacting[pair.object_b] = 1;
+    }
+  }
+  // An implicit floor has no edges; a node within the radius sees it in its features.
+  if (config_.floor != FloorModel::kImplicit || !scene.floor) return;
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    const double lowest = posed_[o].vertices().col(2).minCoeff();
+    if (!scene.objects[o].kinematic && lowest - scene.floor->height < config_.collision_radius) {
+      interacting[o] = 1;
+    }
+  }
 }
 
 void GraphBuilder::build(std::span<const Scene> scenes, Graph& graph) {
@@ -111,18 +175,12 @@ void GraphBuilder::build_scenes(std::span<const Scene> scenes,
   graph.scene_first_object.assign(1, 0);
   face_pairs_.clear();
 
-  const int h = config_.history;
   const bool face_collisions = config_.collisions == CollisionEdges::kFaceFace;
   for (size_t s = 0; s < scenes.size(); ++s) {
     const Scene& scene = scenes[s];
-    validate_scene(scene, static_cast<int>(s));
 
     // 1. The scene's objects, with the floor appended when it is a mesh.
-    objects_.clear();
-    for (const SceneObject& object : scene.objects) objects_.push_back(&object);
-    if (config_.floor == FloorModel::kMesh && scene.floor) {
-      objects_.push_back(&floor_object(scene, static_cast<int>(s)));
-    }
+    gather_objects(scene, static_cast<int>(s));
     const Floor* implicit_floor =
         config_.floor == FloorModel::kImplicit && scene.floor ? &*scene.floor : nullptr;
 
@@ -150,27 +208,12 @@ void GraphBuilder::build_scenes(std::span<const Scene> scenes,
       graph.node_kinematic.insert(graph.node_kinematic.end(), v, object.kinematic ? 1 : 0);
       graph.object_first_node.push_back(first + v);
       graph.object_kinematic.push_back(object.kinematic ? 1 : 0);
-      posed_.push_back({object.mesh, object.positions.data() + static_cast<size_t>(h) * v * 3,
-                        object.kinematic});
+      posed_.push_back(current_pose(object));
     }
 
     // 3. Collision edges between objects within the collision radius.
     contacts_.update(posed_, !face_collisions);
-    if (candidates) {
-      pairs_.clear();
-      for (const ObjectPair& pair : *candidates) {
-        const int n = static_cast<int>(objects_.size());
-        if (pair.a < 0 || pair.b < 0 || pair.a >= n || pair.b >= n || pair.a == pair.b) {
-          throw ConfigError(
-              fmt::format("candidate pair ({}, {}) is not a pair of the scene's {} objects", pair.a,
-                          pair.b, n));
-        }
-        if (posed_[pair.a].kinematic && posed_[pair.b].kinematic) continue;
-        pairs_.push_back({std::min(pair.a, pair.b), std::max(pair.a, pair.b)});
-      }
-    } else {
-      contacts_.find_candidate_pairs(config_.collision_radius, pairs_);
-    }
+    select_pairs(candidates);
     auto first_node = [&](int local_object) {
       return graph.object_first_node[first_object + local_object];
     };

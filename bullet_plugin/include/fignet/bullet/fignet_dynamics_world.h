@@ -33,6 +33,30 @@ struct FIGNetWorldOptions {
   // motion swept against the world (Bullet's convex cast, as Bullet's own CCD does) and stops at
   // the first surface it would cross; the model decides everything slower.
   bool sweep_guard = true;
+  // Free flight: a body with no collision edge this step (nothing within d_c, the floor
+  // included) moves exactly under gravity and its applied forces (constant angular velocity),
+  // without the network, which runs only on the bodies in contact and what they touch; its cost
+  // follows the contacting part of the scene. false: every awake body goes through the network.
+  bool free_flight = true;
+  // Islands whose bodies all want to sleep (Bullet's thresholds and deactivation time) sleep and
+  // wake together when touched, as in Bullet. false: bodies never sleep.
+  bool sleeping = true;
+  // The penetration guard: after the learned step, a body that penetrates static geometry (planes,
+  // triangle meshes, convex shapes) deeper than penetration_tolerance is moved out along the
+  // contact normal and loses the inward part of its velocity, as Bullet's split-impulse recovery
+  // does for its own solver. Depths are Bullet's contact distances (collision margins included).
+  bool penetration_guard = true;
+  double penetration_tolerance = 0.005;  // metres
+
+  // The network alone on every awake body, as `fignet eval` rolls out and the paper measures: no
+  // free flight, no sleeping, no penetration guard (the sweep guard is kept).
+  static FIGNetWorldOptions network_alone() {
+    FIGNetWorldOptions options;
+    options.free_flight = false;
+    options.sleeping = false;
+    options.penetration_guard = false;
+    return options;
+  }
   // Threads for the network's matrix products (see ModelPredictor; 0: every core). One keeps
   // a step from stalling behind the host program's own threads.
   int threads = 1;
@@ -41,11 +65,13 @@ struct FIGNetWorldOptions {
 // What the last internal step simulated and what it cost.
 struct FIGNetStepStats {
   int simulated_bodies = 0;       // awake dynamic bodies predicted by the model
+  int free_flight_bodies = 0;     // awake dynamic bodies moved without it (no collision edge)
   int sleeping_bodies = 0;        // dynamic bodies skipped because Bullet put them to sleep
   int kinematic_objects = 0;      // static and kinematic bodies in contact range, floor excluded
   int candidate_pairs = 0;        // broadphase pairs handed to the face-pair search
   int face_edges = 0;             // face–face edges of the graph
   int guarded_bodies = 0;         // bodies stopped by the tunnelling guard
+  int recovered_bodies = 0;       // bodies moved out of static geometry by the penetration guard
   double prepare_seconds = 0;     // broadphase, islands, meshes and histories
   double predict_seconds = 0;     // graph and network
   double write_back_seconds = 0;  // rigid fits and Bullet state
@@ -79,6 +105,9 @@ class FIGNetDynamicsWorld : public btDiscreteDynamicsWorld {
 
   double model_time_step() const;
   const FIGNetStepStats& last_step_stats() const;
+  // The pose the world keeps for a moving body in double precision (Bullet's transforms are
+  // single precision): what the next step starts from. Other objects: their Bullet transform.
+  Pose precise_pose(const btCollisionObject& object) const;
 
  protected:
   void internalSingleStepSimulation(btScalar time_step) override;

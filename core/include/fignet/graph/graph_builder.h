@@ -36,6 +36,13 @@ class GraphBuilder {
   void build_with_candidates(const Scene& scene, std::span<const ObjectPair> candidates,
                              Graph& graph);
 
+  // Which objects build_with_candidates(scene, candidates) would give a collision edge (face–face
+  // or node–node), or, with an implicit floor, would place within the collision radius of it: one
+  // flag per object, the mesh floor last when there is one. The network's prediction for an object
+  // without any depends on nothing outside it (a physics engine can advance it itself).
+  void find_interacting_objects(const Scene& scene, std::span<const ObjectPair> candidates,
+                                std::vector<char>& interacting);
+
   // The face pairs found by the last build, with object indices into the graph's objects.
   std::span<const FacePair> face_pairs() const { return face_pairs_; }
 
@@ -43,6 +50,11 @@ class GraphBuilder {
   void build_scenes(std::span<const Scene> scenes, const std::span<const ObjectPair>* candidates,
                     Graph& graph);
   void validate_scene(const Scene& scene, int scene_index) const;
+  // The scene's objects into objects_ (validated; the mesh floor appended).
+  void gather_objects(const Scene& scene, int scene_index);
+  PosedMesh current_pose(const SceneObject& object) const;
+  // The pairs to search into pairs_: the caller's (checked), or the builder's own sweep.
+  void select_pairs(const std::span<const ObjectPair>* candidates);
   const SceneObject& floor_object(const Scene& scene, int scene_index);
 
   GraphConfig config_;

@@ -58,6 +58,10 @@ void set_pose_history(SceneObject& object, std::span<const Pose> poses,
 struct Floor {
   double height = 0.0;                         // the floor is the plane z = height, normal +z
   StaticProperties properties{0.0, 0.3, 0.5};  // Kubric's floor: friction 0.3, restitution 0.5
+  // Where the floor mesh (FloorModel::kMesh, GraphConfig::floor_half_extent around this point)
+  // is centred in x and y: the origin in training; a physics engine moves it under bodies far
+  // from the origin.
+  double center_x = 0.0, center_y = 0.0;
 };
 
 struct Scene {
