@@ -7,12 +7,14 @@
 
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "commands.h"
 #include "fignet/error.h"
 #include "fignet/io/model_file.h"
 #include "fignet/io/trajectory_file.h"
 #include "fignet/rollout/evaluation.h"
+#include "fignet/rollout/one_step.h"
 #include "process_group.h"
 #include "progress.h"
 #include "text_file.h"
@@ -27,13 +29,42 @@ struct EvalArgs {
   std::vector<fs::path> models, data;
   fs::path json;
   int frames = -1, max_trajectories = -1, threads = 1;
-  bool baseline = true, penetration = true;
+  bool baseline = true, penetration = true, regimes = true;
 };
 
 struct Row {
   std::string name, kind;
   Evaluation result;
+  std::optional<OneStepTotals> one_step;  // with --regimes (the default)
 };
+
+// What the regime split needs from the (first) model: its graph and its target's scale.
+struct RegimeSetting {
+  GraphConfig graph;
+  Vec3 target_std = Vec3::Ones();
+};
+
+// One-step errors by regime over this process's trajectories, summed over every process on
+// process 0.
+OneStepTotals one_step_by_regime(const std::string& name, AccelerationPredictor& predictor,
+                                 const std::vector<Trajectory>& test,
+                                 const RegimeSetting& setting) {
+  const ProcessGroup& group = process_group();
+  ProgressBar progress(fmt::format("one-step {}", name), static_cast<long long>(test.size()));
+  OneStepOptions options;
+  if (group.is_root()) options.on_trajectory = [&](int done) { progress.update(done); };
+  const OneStepTotals mine =
+      one_step_totals(predictor, setting.graph, setting.target_std, test, options);
+  if (group.is_root()) progress.finish(static_cast<long long>(test.size()));
+  const std::vector<double> gathered = group.collective->gather(mine.serialize());
+  if (!group.is_root()) return mine;
+  const size_t size = mine.serialize().size();
+  OneStepTotals all;
+  for (size_t at = 0; at + size <= gathered.size(); at += size) {
+    all += OneStepTotals::deserialize(std::span(gathered).subspan(at, size));
+  }
+  return all;
+}
 
 std::string kind_of(const ModelConfig& config) {
   return config.graph.collisions == CollisionEdges::kFaceFace ? "FIGNet" : "FIGNet-NoFaceCollision";
@@ -93,6 +124,34 @@ Row evaluate(const std::string& name, const std::string& kind, AccelerationPredi
   return Row{name, kind, summarize(all, options)};
 }
 
+void print_regimes(const std::vector<Row>& rows) {
+  fmt::print(
+      "\none-step error by regime, from every ground-truth frame (free flight: no collision edge "
+      "in the input; rest: in contact and, in the truth, slower than 0.05 m/s and 0.25 rad/s; "
+      "σ: the model's target standard deviation)\n");
+  fmt::print("{:<34} {:<15} {:>7} {:>16} {:>14} {:>9}\n", "run", "regime", "share",
+             "translation (mm)", "rotation (deg)", "RMS (σ)");
+  for (const Row& row : rows) {
+    if (!row.one_step) continue;
+    const OneStepTotals& t = *row.one_step;
+    double samples = 0;
+    for (const RegimeTotals& r : t.regimes) samples += r.samples;
+    for (int k = 0; k < kRegimes; ++k) {
+      const RegimeTotals& r = t.regimes[k];
+      const double n = std::max(r.samples, 1.0);
+      fmt::print("{:<34} {:<15} {:>6.1f}% {:>16.2f} {:>14.3f} {:>9.3f}\n",
+                 k == 0 ? fmt::format("{} ({})", row.name, row.kind) : "",
+                 regime_name(static_cast<Regime>(k)), 100.0 * r.samples / std::max(samples, 1.0),
+                 1e3 * r.translation / n, r.rotation / n,
+                 std::sqrt(r.squared_sigmas / std::max(r.components, 1.0)));
+    }
+    fmt::print(
+        "{:<34} impacts (|a - g| > 2 g): {:.0f} object-steps, {:.0f} ({:.1f}%) with no "
+        "collision edge in their input\n",
+        "", t.impacts, t.unseen_impacts, 100.0 * t.unseen_impacts / std::max(t.impacts, 1.0));
+  }
+}
+
 void print_table(const std::vector<Row>& rows) {
   fmt::print("\n{:<34} {:>21} {:>21} {:>15} {:>10} {:>8}\n", "", "translation (m)",
              "rotation (deg)", "penetration", "face-face", "");
@@ -122,8 +181,24 @@ nlohmann::json to_json(const Row& row) {
                               {"mean_rotation_deg", t.mean_rotation},
                               {"final_rotation_deg", t.final_rotation}});
   }
+  nlohmann::json regimes = nullptr;
+  if (row.one_step) {
+    regimes = nlohmann::json::object();
+    for (int k = 0; k < kRegimes; ++k) {
+      const RegimeTotals& r = row.one_step->regimes[k];
+      const double n = std::max(r.samples, 1.0);
+      regimes[std::string(regime_name(static_cast<Regime>(k)))] = {
+          {"object_steps", r.samples},
+          {"mean_translation_m", r.translation / n},
+          {"mean_rotation_deg", r.rotation / n},
+          {"rms_sigmas", std::sqrt(r.squared_sigmas / std::max(r.components, 1.0))}};
+    }
+    regimes["impacts"] = row.one_step->impacts;
+    regimes["unseen_impacts"] = row.one_step->unseen_impacts;
+  }
   return {{"name", row.name},
           {"kind", row.kind},
+          {"one_step_by_regime", regimes},
           {"trajectories", e.trajectories},
           {"mean_translation_m", e.mean_translation},
           {"final_translation_m", e.final_translation},
@@ -143,6 +218,7 @@ void run_eval(const EvalArgs& args) {
   const bool root = process_group().is_root();
   std::vector<Row> rows;
   int history = 2;
+  std::optional<RegimeSetting> regimes;
   for (const fs::path& file : args.models) {
     auto model = std::make_shared<const Model>(load_model(file));
     const ModelConfig& config = model->config();
@@ -152,12 +228,24 @@ void run_eval(const EvalArgs& args) {
     }
     history = config.graph.history;
     ModelPredictor predictor(model, args.threads);
-    rows.push_back(evaluate(file.filename().string(), kind_of(config), predictor, test, args));
+    const std::string name = file.filename().string();
+    rows.push_back(evaluate(name, kind_of(config), predictor, test, args));
+    if (args.regimes) {
+      // Every row is split by the first model's graph, in its units.
+      if (!regimes) {
+        const Eigen::RowVectorXf& std = model->normalizers().target.std();
+        regimes = RegimeSetting{config.graph, Vec3(std(0), std(1), std(2))};
+      }
+      rows.back().one_step = one_step_by_regime(name, predictor, test, *regimes);
+    }
   }
   if (args.baseline) {
     // Constant velocity under gravity from the same given frames: what no contact model gives.
     GravityPredictor ballistic(test[0].gravity, test[0].time_step, history);
     rows.push_back(evaluate("ballistic", "constant velocity + gravity", ballistic, test, args));
+    if (regimes && regimes->graph.history == history) {
+      rows.back().one_step = one_step_by_regime("ballistic", ballistic, test, *regimes);
+    }
   }
   if (!root) return;
   const int trajectories = rows.front().result.trajectories;
@@ -167,6 +255,7 @@ void run_eval(const EvalArgs& args) {
              args.frames > 0 ? args.frames : test[0].num_frames(), history + 1,
              fmt::join(files, ", "));
   print_table(rows);
+  if (regimes) print_regimes(rows);
   if (!args.json.empty()) {
     nlohmann::json out = {{"data", nlohmann::json::array()},
                           {"trajectories", trajectories},
@@ -205,6 +294,9 @@ void add_eval_command(CLI::App& app) {
   cmd->add_flag("!--no-baseline", args->baseline, "Leave out the ballistic baseline");
   cmd->add_flag("!--no-penetration", args->penetration,
                 "Skip the penetration ratios (the costliest metric)");
+  cmd->add_flag("!--no-regimes", args->regimes,
+                "Skip the one-step errors by regime (free flight, moving contact, rest) and the "
+                "count of impacts without a collision edge");
   cmd->add_option("--threads", args->threads,
                   "Threads for the network's matrix products (0: every core; more than one "
                   "only helps large scenes on an otherwise idle machine)")

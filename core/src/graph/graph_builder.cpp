@@ -121,12 +121,22 @@ void GraphBuilder::select_pairs(const std::span<const ObjectPair>* candidates) {
 void GraphBuilder::find_interacting_objects(const Scene& scene,
                                             std::span<const ObjectPair> candidates,
                                             std::vector<char>& interacting) {
+  find_interacting(scene, &candidates, interacting);
+}
+
+void GraphBuilder::find_interacting_objects(const Scene& scene, std::vector<char>& interacting) {
+  find_interacting(scene, nullptr, interacting);
+}
+
+void GraphBuilder::find_interacting(const Scene& scene,
+                                    const std::span<const ObjectPair>* candidates,
+                                    std::vector<char>& interacting) {
   gather_objects(scene, 0);
   posed_.clear();
   for (const SceneObject* object : objects_) posed_.push_back(current_pose(*object));
   const bool face_collisions = config_.collisions == CollisionEdges::kFaceFace;
   contacts_.update(posed_, !face_collisions);
-  select_pairs(&candidates);
+  select_pairs(candidates);
   interacting.assign(objects_.size(), 0);
   // The same search build() makes: a collision edge marks both of its objects.
   if (face_collisions) {

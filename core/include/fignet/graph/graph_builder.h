@@ -42,6 +42,8 @@ class GraphBuilder {
   // without any depends on nothing outside it (a physics engine can advance it itself).
   void find_interacting_objects(const Scene& scene, std::span<const ObjectPair> candidates,
                                 std::vector<char>& interacting);
+  // The same with the pairs build(scene) would examine (the builder's own sweep).
+  void find_interacting_objects(const Scene& scene, std::vector<char>& interacting);
 
   // The face pairs found by the last build, with object indices into the graph's objects.
   std::span<const FacePair> face_pairs() const { return face_pairs_; }
@@ -55,6 +57,8 @@ class GraphBuilder {
   PosedMesh current_pose(const SceneObject& object) const;
   // The pairs to search into pairs_: the caller's (checked), or the builder's own sweep.
   void select_pairs(const std::span<const ObjectPair>* candidates);
+  void find_interacting(const Scene& scene, const std::span<const ObjectPair>* candidates,
+                        std::vector<char>& interacting);
   const SceneObject& floor_object(const Scene& scene, int scene_index);
 
   GraphConfig config_;

@@ -1,0 +1,58 @@
+// One-step errors split by what the input graph shows of each object (issue 13's diagnostics):
+// from every ground-truth frame, the predicted next pose of each dynamic object against the
+// truth, grouped into free flight (no collision edge), moving contact and rest (in contact, the
+// truth nearly still); and impacts the predictor could not see: a large acceleration of an object
+// that had no collision edge in its input.
+#pragma once
+
+#include <array>
+#include <functional>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "fignet/data/trajectory.h"
+#include "fignet/graph/config.h"
+#include "fignet/rollout/predictor.h"
+
+namespace fignet {
+
+enum class Regime { kFreeFlight = 0, kContact = 1, kRest = 2 };
+inline constexpr int kRegimes = 3;
+std::string_view regime_name(Regime regime);
+
+struct OneStepOptions {
+  // Rest: in contact and, in the truth, moving slower than these over the predicted step.
+  double rest_speed = 0.05;          // m/s of the centre of mass
+  double rest_angular_speed = 0.25;  // rad/s
+  // Impact: the truth's centre-of-mass acceleration differs from gravity by more than this many
+  // g (resting contact differs by one g).
+  double impact_g = 2.0;
+  std::function<void(int done)> on_trajectory;  // progress: called after each trajectory
+};
+
+// Sums, so that shares of trajectories (threads, processes) add up.
+struct RegimeTotals {
+  double samples = 0;         // object-steps
+  double translation = 0;     // Σ |x̂ − x| of the centre of mass, metres
+  double rotation = 0;        // Σ angle between predicted and true orientation, degrees
+  double squared_sigmas = 0;  // Σ over vertex components of ((â − a)/σ)², σ: the target's std
+  double components = 0;      // vertex components summed there
+};
+
+struct OneStepTotals {
+  std::array<RegimeTotals, kRegimes> regimes{};
+  double impacts = 0, unseen_impacts = 0;  // object-steps
+  OneStepTotals& operator+=(const OneStepTotals& other);
+  std::vector<double> serialize() const;
+  static OneStepTotals deserialize(std::span<const double> values);
+};
+
+// One-step predictions from every frame t ≥ h with a next frame. Regimes come from a graph built
+// with `graph` (the model's config; the builder's own pair search). `target_std` scales vertex
+// acceleration errors into the model's normalised units (per component).
+OneStepTotals one_step_totals(AccelerationPredictor& predictor, const GraphConfig& graph,
+                              const Vec3& target_std, std::span<const Trajectory> truths,
+                              const OneStepOptions& options = {});
+
+}  // namespace fignet

@@ -1,0 +1,140 @@
+#include "fignet/rollout/one_step.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "fignet/error.h"
+#include "fignet/graph/graph_builder.h"
+#include "fignet/rollout/rollout.h"
+
+namespace fignet {
+
+std::string_view regime_name(Regime regime) {
+  switch (regime) {
+    case Regime::kFreeFlight:
+      return "free flight";
+    case Regime::kContact:
+      return "moving contact";
+    case Regime::kRest:
+      return "rest";
+  }
+  return "?";
+}
+
+OneStepTotals& OneStepTotals::operator+=(const OneStepTotals& other) {
+  for (int r = 0; r < kRegimes; ++r) {
+    RegimeTotals& mine = regimes[r];
+    const RegimeTotals& theirs = other.regimes[r];
+    mine.samples += theirs.samples;
+    mine.translation += theirs.translation;
+    mine.rotation += theirs.rotation;
+    mine.squared_sigmas += theirs.squared_sigmas;
+    mine.components += theirs.components;
+  }
+  impacts += other.impacts;
+  unseen_impacts += other.unseen_impacts;
+  return *this;
+}
+
+std::vector<double> OneStepTotals::serialize() const {
+  std::vector<double> out;
+  for (const RegimeTotals& r : regimes) {
+    out.insert(out.end(), {r.samples, r.translation, r.rotation, r.squared_sigmas, r.components});
+  }
+  out.insert(out.end(), {impacts, unseen_impacts});
+  return out;
+}
+
+OneStepTotals OneStepTotals::deserialize(std::span<const double> values) {
+  constexpr size_t kSize = 5 * kRegimes + 2;
+  if (values.size() != kSize) {
+    throw ConfigError("OneStepTotals: expected " + std::to_string(kSize) + " values, got " +
+                      std::to_string(values.size()));
+  }
+  OneStepTotals totals;
+  for (int r = 0; r < kRegimes; ++r) {
+    const double* v = values.data() + 5 * r;
+    totals.regimes[r] = {v[0], v[1], v[2], v[3], v[4]};
+  }
+  totals.impacts = values[5 * kRegimes];
+  totals.unseen_impacts = values[5 * kRegimes + 1];
+  return totals;
+}
+
+OneStepTotals one_step_totals(AccelerationPredictor& predictor, const GraphConfig& graph,
+                              const Vec3& target_std, std::span<const Trajectory> truths,
+                              const OneStepOptions& options) {
+  if (!(target_std.array() > 0).all()) {
+    throw ConfigError("one_step_totals: target_std must be positive");
+  }
+  const int h = predictor.history();
+  if (h < 1 || graph.history != h) {
+    throw ConfigError(
+        fmt::format("one_step_totals: the predictor's history ({}) must be >= 1 "
+                    "and equal the graph config's ({})",
+                    h, graph.history));
+  }
+  GraphBuilder builder(graph);
+  OneStepTotals totals;
+  Scene scene;
+  StepWorkspace workspace;  // integrate_next_poses reads its accelerations
+  const Points& accelerations = workspace.accelerations;
+  std::vector<Pose> next;
+  std::vector<char> interacting;
+  const Eigen::Array3d inverse_std = target_std.array().inverse();
+  int done = 0;
+  for (const Trajectory& truth : truths) {
+    truth.validate();
+    const double dt = truth.time_step;
+    const double g = truth.gravity.norm();
+    for (int t = h; t + 1 < truth.num_frames(); ++t) {
+      scene_at_frame(truth, t, h, scene);
+      builder.find_interacting_objects(scene, interacting);
+      predictor.predict(scene, workspace.accelerations);
+      integrate_next_poses(scene, next, workspace);
+      Eigen::Index row = 0;
+      for (size_t o = 0; o < scene.objects.size(); ++o) {
+        const SceneObject& object = scene.objects[o];
+        const Eigen::Index v = object.mesh->num_vertices();
+        const Eigen::Index first = row;
+        row += v;
+        if (object.kinematic) continue;
+        const std::vector<Pose>& poses = truth.objects[o].poses;
+        const Pose &before = poses[t - 1], &now = poses[t], &after = poses[t + 1];
+        // The truth's motion over the step, and its centre's acceleration against gravity.
+        const double speed = (after.position - now.position).norm() / dt;
+        const double angular_speed = now.orientation.angularDistance(after.orientation) / dt;
+        const Vec3 acceleration =
+            (after.position - 2.0 * now.position + before.position) / (dt * dt);
+        const bool edge = interacting[o] != 0;
+        if ((acceleration - truth.gravity).norm() > options.impact_g * g) {
+          totals.impacts += 1;
+          if (!edge) totals.unseen_impacts += 1;
+        }
+        const Regime regime =
+            !edge ? Regime::kFreeFlight
+            : speed < options.rest_speed && angular_speed < options.rest_angular_speed
+                ? Regime::kRest
+                : Regime::kContact;
+        RegimeTotals& r = totals.regimes[static_cast<int>(regime)];
+        r.samples += 1;
+        r.translation += (next[o].position - after.position).norm();
+        r.rotation +=
+            next[o].orientation.angularDistance(after.orientation) * 180.0 / std::numbers::pi;
+        // Vertex accelerations in the model's normalised units.
+        const Points truth_next = posed_vertices(*object.mesh, after);
+        const Points true_acceleration =
+            truth_next - 2.0 * object.positions_at(h) + object.positions_at(h - 1);
+        const Points error = accelerations.middleRows(first, v) - true_acceleration;
+        r.squared_sigmas += (error.array().rowwise() * inverse_std.transpose()).square().sum();
+        r.components += 3.0 * static_cast<double>(v);
+      }
+    }
+    if (options.on_trajectory) options.on_trajectory(++done);
+  }
+  return totals;
+}
+
+}  // namespace fignet
