@@ -138,12 +138,10 @@ void print_regimes(const std::vector<Row>& rows) {
     for (const RegimeTotals& r : t.regimes) samples += r.samples;
     for (int k = 0; k < kRegimes; ++k) {
       const RegimeTotals& r = t.regimes[k];
-      const double n = std::max(r.samples, 1.0);
       fmt::print("{:<34} {:<15} {:>6.1f}% {:>16.2f} {:>14.3f} {:>9.3f}\n",
                  k == 0 ? fmt::format("{} ({})", row.name, row.kind) : "",
                  regime_name(static_cast<Regime>(k)), 100.0 * r.samples / std::max(samples, 1.0),
-                 1e3 * r.translation / n, r.rotation / n,
-                 std::sqrt(r.squared_sigmas / std::max(r.components, 1.0)));
+                 1e3 * mean_translation(r), r.rotation / std::max(r.samples, 1.0), rms_sigmas(r));
     }
     fmt::print(
         "{:<34} impacts (|a - g| > 2 g): {:.0f} object-steps, {:.0f} ({:.1f}%) with no "
@@ -186,12 +184,11 @@ nlohmann::json to_json(const Row& row) {
     regimes = nlohmann::json::object();
     for (int k = 0; k < kRegimes; ++k) {
       const RegimeTotals& r = row.one_step->regimes[k];
-      const double n = std::max(r.samples, 1.0);
       regimes[std::string(regime_name(static_cast<Regime>(k)))] = {
           {"object_steps", r.samples},
-          {"mean_translation_m", r.translation / n},
-          {"mean_rotation_deg", r.rotation / n},
-          {"rms_sigmas", std::sqrt(r.squared_sigmas / std::max(r.components, 1.0))}};
+          {"mean_translation_m", mean_translation(r)},
+          {"mean_rotation_deg", r.rotation / std::max(r.samples, 1.0)},
+          {"rms_sigmas", rms_sigmas(r)}};
     }
     regimes["impacts"] = row.one_step->impacts;
     regimes["unseen_impacts"] = row.one_step->unseen_impacts;

@@ -194,12 +194,22 @@ void run_train(const TrainArgs& args) {
       // One thread per trajectory (Eigen runs each predictor's products on its own thread
       // inside a parallel region; 0 leaves its process-wide setting alone).
       const std::shared_ptr<const Model> model = trainer.model();
-      const Evaluation e =
-          evaluate_rollouts_parallel([&] { return std::make_unique<ModelPredictor>(model, 0); },
-                                     valid, std::max(1, omp_get_max_threads()));
-      log->write_validation(step.step, e);
-      fmt::print(stderr, "\nstep {}: validation translation {:.4f} m, rotation {:.2f} deg\n",
-                 step.step, e.mean_translation, e.mean_rotation);
+      const auto make_predictor = [&] { return std::make_unique<ModelPredictor>(model, 0); };
+      const int threads = std::max(1, omp_get_max_threads());
+      const Evaluation e = evaluate_rollouts_parallel(make_predictor, valid, threads);
+      // Where the error is: free flight, moving contact, rest (in the model's units too).
+      const Eigen::RowVectorXf& target_std = model->normalizers().target.std();
+      const OneStepTotals one_step = one_step_totals_parallel(
+          make_predictor, model->config().graph, Vec3(target_std(0), target_std(1), target_std(2)),
+          valid, threads);
+      log->write_validation(step.step, e, one_step);
+      fmt::print(stderr,
+                 "\nstep {}: validation translation {:.4f} m, rotation {:.2f} deg; one step: free "
+                 "flight {:.2f} mm, moving contact {:.2f} mm, rest {:.2f} mm\n",
+                 step.step, e.mean_translation, e.mean_rotation,
+                 1e3 * mean_translation(one_step.regimes[0]),
+                 1e3 * mean_translation(one_step.regimes[1]),
+                 1e3 * mean_translation(one_step.regimes[2]));
     }
     const auto now = std::chrono::steady_clock::now();
     if (std::chrono::duration<double>(now - last_checkpoint).count() >=

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -37,14 +38,23 @@ void TrainingLog::write_step(std::int64_t step, double loss, float learning_rate
        << std::endl;
 }
 
-void TrainingLog::write_validation(std::int64_t step, const Evaluation& e) {
-  out_ << nlohmann::json{{"step", step},
-                         {"valid_translation_m", e.mean_translation},
-                         {"valid_rotation_deg", e.mean_rotation},
-                         {"valid_final_translation_m", e.final_translation},
-                         {"valid_final_rotation_deg", e.final_rotation}}
-              .dump()
-       << std::endl;
+void TrainingLog::write_validation(std::int64_t step, const Evaluation& e,
+                                   const OneStepTotals& one_step) {
+  nlohmann::json line{{"step", step},
+                      {"valid_translation_m", e.mean_translation},
+                      {"valid_rotation_deg", e.mean_rotation},
+                      {"valid_final_translation_m", e.final_translation},
+                      {"valid_final_rotation_deg", e.final_rotation},
+                      {"valid_impacts", one_step.impacts},
+                      {"valid_unseen_impacts", one_step.unseen_impacts}};
+  // valid_one_step_m_free_flight, valid_one_step_sigma_moving_contact, …
+  for (int r = 0; r < kRegimes; ++r) {
+    std::string name(regime_name(static_cast<Regime>(r)));
+    std::replace(name.begin(), name.end(), ' ', '_');
+    line["valid_one_step_m_" + name] = mean_translation(one_step.regimes[r]);
+    line["valid_one_step_sigma_" + name] = rms_sigmas(one_step.regimes[r]);
+  }
+  out_ << line.dump() << std::endl;
 }
 
 }  // namespace fignet::cli

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "fignet/rollout/evaluation.h"
+#include "fignet/rollout/one_step.h"
 
 namespace fignet::cli {
 
@@ -18,7 +19,9 @@ class TrainingLog {
 
   void write_step(std::int64_t step, double loss, float learning_rate, double steps_per_second,
                   double gradient_norm);
-  void write_validation(std::int64_t step, const Evaluation& evaluation);
+  // Validation rollouts and the one-step errors by regime of the same trajectories.
+  void write_validation(std::int64_t step, const Evaluation& evaluation,
+                        const OneStepTotals& one_step);
 
  private:
   std::ofstream out_;

@@ -87,6 +87,18 @@ TEST(OneStep, RegimesAndUnseenImpactsOfADrop) {
   EXPECT_EQ(twice.regimes[2].samples, 2 * totals.regimes[2].samples);
   EXPECT_EQ(twice.unseen_impacts, 2 * totals.unseen_impacts);
   EXPECT_THROW(OneStepTotals::deserialize(std::vector<double>(3)), ConfigError);
+
+  // Shared among threads, each with its own predictor: the same sums.
+  const std::vector<Trajectory> three = {truth, truth, truth};
+  const OneStepTotals threaded = one_step_totals_parallel(
+      [&] { return std::make_unique<GravityPredictor>(g, dt, 2); }, graph, sigma, three, 2);
+  for (int r = 0; r < kRegimes; ++r) {
+    EXPECT_EQ(threaded.regimes[r].samples, 3 * totals.regimes[r].samples);
+    EXPECT_NEAR(threaded.regimes[r].translation, 3 * totals.regimes[r].translation, 1e-9);
+    EXPECT_NEAR(mean_translation(threaded.regimes[r]), mean_translation(totals.regimes[r]), 1e-12);
+    EXPECT_NEAR(rms_sigmas(threaded.regimes[r]), rms_sigmas(totals.regimes[r]), 1e-12);
+  }
+  EXPECT_EQ(threaded.unseen_impacts, 3 * totals.unseen_impacts);
 }
 
 }  // namespace

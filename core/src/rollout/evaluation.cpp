@@ -6,6 +6,7 @@
 
 #include "fignet/error.h"
 #include "fignet/rollout/rollout.h"
+#include "per_trajectory_threads.h"
 
 namespace fignet {
 
@@ -84,24 +85,12 @@ Evaluation evaluate_rollouts_parallel(
     std::span<const Trajectory> truths, int threads, const EvaluationOptions& options) {
   EvaluationOptions quiet = options;
   quiet.on_trajectory = nullptr;
-  const int n = static_cast<int>(truths.size());
   std::vector<EvaluationTotals> each(truths.size());
-  std::exception_ptr failure;
-#pragma omp parallel num_threads(std::max(1, std::min(threads, n)))
-  {
-    std::unique_ptr<AccelerationPredictor> predictor;
-#pragma omp for schedule(dynamic, 1)
-    for (int i = 0; i < n; ++i) {
-      try {
-        if (!predictor) predictor = make_predictor();
-        each[i] = evaluate_rollout_totals(*predictor, truths.subspan(i, 1), quiet);
-      } catch (...) {
-#pragma omp critical
-        if (!failure) failure = std::current_exception();
-      }
-    }
-  }
-  if (failure) std::rethrow_exception(failure);
+  detail::for_each_trajectory(make_predictor, static_cast<int>(truths.size()), threads,
+                              [&](AccelerationPredictor& predictor, int i) {
+                                each[i] =
+                                    evaluate_rollout_totals(predictor, truths.subspan(i, 1), quiet);
+                              });
   EvaluationTotals totals;
   for (const EvaluationTotals& t : each) totals += t;
   return summarize(totals, options);

@@ -8,6 +8,7 @@
 #include "fignet/error.h"
 #include "fignet/graph/graph_builder.h"
 #include "fignet/rollout/rollout.h"
+#include "per_trajectory_threads.h"
 
 namespace fignet {
 
@@ -135,6 +136,31 @@ OneStepTotals one_step_totals(AccelerationPredictor& predictor, const GraphConfi
     if (options.on_trajectory) options.on_trajectory(++done);
   }
   return totals;
+}
+
+OneStepTotals one_step_totals_parallel(
+    const std::function<std::unique_ptr<AccelerationPredictor>()>& make_predictor,
+    const GraphConfig& graph, const Vec3& target_std, std::span<const Trajectory> truths,
+    int threads, const OneStepOptions& options) {
+  OneStepOptions quiet = options;
+  quiet.on_trajectory = nullptr;
+  std::vector<OneStepTotals> each(truths.size());
+  detail::for_each_trajectory(make_predictor, static_cast<int>(truths.size()), threads,
+                              [&](AccelerationPredictor& predictor, int i) {
+                                each[i] = one_step_totals(predictor, graph, target_std,
+                                                          truths.subspan(i, 1), quiet);
+                              });
+  OneStepTotals totals;
+  for (const OneStepTotals& t : each) totals += t;
+  return totals;
+}
+
+double mean_translation(const RegimeTotals& totals) {
+  return totals.samples > 0 ? totals.translation / totals.samples : 0.0;
+}
+
+double rms_sigmas(const RegimeTotals& totals) {
+  return totals.components > 0 ? std::sqrt(totals.squared_sigmas / totals.components) : 0.0;
 }
 
 }  // namespace fignet

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <functional>
+#include <memory>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -54,5 +55,18 @@ struct OneStepTotals {
 OneStepTotals one_step_totals(AccelerationPredictor& predictor, const GraphConfig& graph,
                               const Vec3& target_std, std::span<const Trajectory> truths,
                               const OneStepOptions& options = {});
+
+// The same with the trajectories shared among `threads` threads, each with a predictor of its own
+// from `make_predictor`; totals are summed in trajectory order, so they equal the one-thread
+// result (on_trajectory is not called).
+OneStepTotals one_step_totals_parallel(
+    const std::function<std::unique_ptr<AccelerationPredictor>()>& make_predictor,
+    const GraphConfig& graph, const Vec3& target_std, std::span<const Trajectory> truths,
+    int threads, const OneStepOptions& options = {});
+
+// Per regime: mean translation error in metres and vertex-acceleration RMS in σ (0 when the
+// regime has no sample).
+double mean_translation(const RegimeTotals& totals);
+double rms_sigmas(const RegimeTotals& totals);
 
 }  // namespace fignet
