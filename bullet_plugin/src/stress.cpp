@@ -83,6 +83,21 @@ StressCase make_case(std::string name, std::string group, SceneSpec scene, bool 
 std::vector<StressCase> stress_cases(double scale_frames) {
   const auto frames = [&](int n) { return std::max(8, static_cast<int>(n * scale_frames)); };
   std::vector<StressCase> cases;
+  // Canonical scenes (issue 13), each one behaviour a model must get right; with "one cube at
+  // rest" and "stack of 2 cubes" below they are the quick check of any model (--case canonical,
+  // --case rest, --case "stack of 2").
+  SceneSpec dropped = empty_scene(frames(96));
+  dropped.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 1.5)));
+  cases.push_back(make_case("canonical: cube dropped from 1 m", "canonical", dropped, false));
+  SceneSpec sliding = empty_scene(frames(96));
+  sliding.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 0.5)));
+  sliding.bodies.back().linear_velocity = Vec3(3, 0, 0);
+  cases.push_back(make_case("canonical: cube sliding at 3 m/s", "canonical", sliding, false));
+  SceneSpec bouncing = empty_scene(frames(144));
+  bouncing.floor->properties.restitution = 0.9;
+  bouncing.bodies.push_back(make_body(make_sphere(0.3, 8, 12), kDensity, 0.5, 0.9));
+  bouncing.bodies.back().pose.position = Vec3(0, 0, 2);
+  cases.push_back(make_case("canonical: sphere bouncing from 2 m", "canonical", bouncing, false));
   // Rest: drift of one body and of a settled pile over 2000 steps.
   SceneSpec one = empty_scene(frames(2000));
   one.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 0.5)));
