@@ -288,12 +288,12 @@ TEST(FIGNetWorld, RestingBodiesSleepAndWakeWhenTouched) {
    public:
     Still() : RecordingPredictor(Vec3::Zero(), 1.0 / 48.0) {}
   };
+  // With the world's defaults (free flight, guard) on a floor, so that the resting bodies are in
+  // contact and go through the predictor.
   auto predictor = std::make_unique<Still>();
   auto* recorder = predictor.get();
-  FIGNetWorldOptions options = network_alone();
-  options.allow_gravity_mismatch = true;
-  options.sleeping = true;
-  WorldFixture fixture(std::move(predictor), {}, options);
+  WorldFixture fixture(std::move(predictor));
+  fixture.add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0, Pose{});
   btRigidBody* resting = fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0,
                                      at(Vec3(0, 0, 0.2)));
   btRigidBody* far = fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0,
@@ -309,6 +309,17 @@ TEST(FIGNetWorld, RestingBodiesSleepAndWakeWhenTouched) {
   fixture.step();
   EXPECT_TRUE(resting->isActive());
   EXPECT_EQ(recorder->last_scene.objects.size(), 2u);
+  EXPECT_EQ(fixture.world.last_step_stats().simulated_bodies, 2);
+  // Without sleeping, nothing sleeps.
+  FIGNetWorldOptions awake;
+  awake.sleeping = false;
+  WorldFixture restless(std::make_unique<Still>(), {}, awake);
+  restless.add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0, Pose{});
+  btRigidBody* box = restless.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0,
+                                  at(Vec3(0, 0, 0.2)));
+  restless.step(150);
+  EXPECT_TRUE(box->isActive());
+  EXPECT_EQ(restless.world.last_step_stats().sleeping_bodies, 0);
 }
 
 TEST(FIGNetWorld, CollisionFilteringKeepsFilteredPairsOutOfTheGraph) {
