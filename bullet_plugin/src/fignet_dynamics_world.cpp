@@ -363,27 +363,17 @@ struct FIGNetDynamicsWorld::Impl {
   }
 
   // Free flight: x_{t+1} = 2x_t − x_{t−1} + g·dt², exact for constant acceleration (applied
-  // forces are already in the history's last velocity), and the last step's rotation again.
+  // forces are already in the history's last velocity), and the last step's rotation again (the
+  // graph config guarantees a history of at least one past pose).
   Pose free_flight_pose(const btRigidBody& body) const {
     const std::vector<Pose>& poses = states.at(&body).poses;
     const Pose& current = poses.back();
-    const Vec3 g = from_bt(body.getGravity());
+    const Pose& previous = poses[poses.size() - 2];
     Pose next;
-    if (poses.size() < 2) {  // no history: Bullet's velocities
-      next.position = current.position + time_step * from_bt(body.getLinearVelocity()) +
-                      time_step * time_step * g;
-      const Vec3 turn = time_step * from_bt(body.getAngularVelocity());
-      next.orientation =
-          turn.norm() > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(turn.norm(), turn.normalized())) *
-                                current.orientation
-                          : current.orientation;
-    } else {
-      const Pose& previous = poses[poses.size() - 2];
-      next.position = 2.0 * current.position - previous.position + time_step * time_step * g;
-      next.orientation =
-          current.orientation * previous.orientation.conjugate() * current.orientation;
-    }
-    next.orientation.normalize();
+    next.position = 2.0 * current.position - previous.position +
+                    time_step * time_step * from_bt(body.getGravity());
+    next.orientation =
+        (current.orientation * previous.orientation.conjugate() * current.orientation).normalized();
     return next;
   }
 
@@ -502,19 +492,13 @@ struct FIGNetDynamicsWorld::Impl {
         if (contact.depth <= options.penetration_tolerance) break;
         const Vec3 push = contact.depth * contact.out;
         for (Pose& pose : state.poses) pose.position += push;
-        // v' = v − min(0, v·n)·n; the previous poses shift to match it.
+        // v' = v − min(0, v·n)·n, v the history's last velocity (what write_back gave Bullet);
+        // the previous poses shift to match it.
         const size_t h = state.poses.size() - 1;
-        if (h > 0) {
-          const Vec3 velocity = (state.poses[h].position - state.poses[h - 1].position) / time_step;
-          const double inward = velocity.dot(contact.out);
-          if (inward < 0) {
-            for (size_t k = 0; k < h; ++k)
-              state.poses[k].position += inward * time_step * contact.out;
-          }
-        }
-        Vec3 velocity = from_bt(body->getLinearVelocity());
-        velocity -= std::min(0.0, velocity.dot(contact.out)) * contact.out;
-        body->setLinearVelocity(to_bt(velocity));
+        const Vec3 velocity = (state.poses[h].position - state.poses[h - 1].position) / time_step;
+        const double inward = std::min(0.0, velocity.dot(contact.out));
+        for (size_t k = 0; k < h; ++k) state.poses[k].position += inward * time_step * contact.out;
+        body->setLinearVelocity(to_bt(Vec3(velocity - inward * contact.out)));
         body->proceedToTransform(to_bt(state.poses.back()));
         moved = true;
       }

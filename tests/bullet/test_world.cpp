@@ -18,7 +18,6 @@
 namespace fignet::bullet {
 namespace {
 
-using testing::network_alone;
 using testing::recording_predictor;
 using testing::WorldFixture;
 
@@ -36,7 +35,7 @@ Pose at(const Vec3& position,
 TEST(FIGNetWorld, FreeFlightFollowsTheAnalyticTrajectory) {
   for (const bool free_flight : {true, false}) {
     SCOPED_TRACE(free_flight ? "free-flight path" : "through the predictor");
-    FIGNetWorldOptions options = network_alone();
+    FIGNetWorldOptions options = FIGNetWorldOptions::network_alone();
     options.free_flight = free_flight;
     auto predictor = recording_predictor();
     const auto* recorder = predictor.get();
@@ -198,7 +197,7 @@ TEST(ShapeMeshes, UnsupportedShapesNameThemselves) {
 TEST(FIGNetWorld, ShapeMeshesCanBeGivenAndMustFitTheShape) {
   auto predictor = recording_predictor();
   testing::RecordingPredictor& recorder = *predictor;
-  WorldFixture fixture(std::move(predictor), {}, network_alone());
+  WorldFixture fixture(std::move(predictor), {}, FIGNetWorldOptions::network_alone());
   auto shape = std::make_unique<btBoxShape>(btVector3(0.5, 0.5, 0.5));
   const btCollisionShape& box = *shape;
   Pose pose;
@@ -262,7 +261,7 @@ TEST(FIGNetWorld, RejectsAnotherTimeStepOrGravity) {
 TEST(FIGNetWorld, BodiesComeAndGoMidRunAndVelocityChangesReseedHistory) {
   auto predictor = recording_predictor();
   auto* recorder = predictor.get();
-  WorldFixture fixture(std::move(predictor), {}, network_alone());
+  WorldFixture fixture(std::move(predictor), {}, FIGNetWorldOptions::network_alone());
   btRigidBody* first = fixture.add(std::make_unique<btSphereShape>(0.1f), 1.0, at(Vec3(0, 0, 5)));
   fixture.step(3);
   btRigidBody* second = fixture.add(std::make_unique<btSphereShape>(0.1f), 1.0, at(Vec3(3, 0, 5)));
@@ -325,7 +324,7 @@ TEST(FIGNetWorld, RestingBodiesSleepAndWakeWhenTouched) {
 TEST(FIGNetWorld, CollisionFilteringKeepsFilteredPairsOutOfTheGraph) {
   auto predictor = recording_predictor();
   auto* recorder = predictor.get();
-  WorldFixture fixture(std::move(predictor), {}, network_alone());
+  WorldFixture fixture(std::move(predictor), {}, FIGNetWorldOptions::network_alone());
   const int group_a = 2, group_b = 4;
   auto add_box = [&](const Vec3& p, int group, int mask) {
     auto shape = std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f));
@@ -379,7 +378,7 @@ TEST(FIGNetWorld, ARealModelStepsAMoviASceneWithoutNaNAsEvalRolloutsDo) {
                                   btCollisionConfiguration* c) {
                                 // The network alone, as core rollouts run it: none of the
                                 // world's additions (the guards, free flight, sleeping).
-                                FIGNetWorldOptions options = network_alone();
+                                FIGNetWorldOptions options = FIGNetWorldOptions::network_alone();
                                 options.sweep_guard = false;
                                 return std::make_unique<FIGNetDynamicsWorld>(d, b, s, c, model,
                                                                              options);
@@ -420,7 +419,6 @@ TEST(FIGNetWorld, ARealModelStepsAMoviASceneWithoutNaNAsEvalRolloutsDo) {
 namespace fignet::bullet {
 namespace {
 
-using testing::network_alone;
 using testing::WorldFixture;
 
 // A model that always answers "fall": every node accelerates by 3 g, contact or not.
@@ -519,7 +517,7 @@ TEST(FIGNetWorld, FreeFlightLeavesBodiesInContactAsTheNetworkMovesThem) {
   for (const bool with_flyer : {false, true}) {
     for (const bool free_flight : {false, true}) {
       SCOPED_TRACE(fmt::format("flyer {}, free flight {}", with_flyer, free_flight));
-      FIGNetWorldOptions options = network_alone();
+      FIGNetWorldOptions options = FIGNetWorldOptions::network_alone();
       options.free_flight = free_flight;
       ModelScene scene(options);
       std::vector<btRigidBody*> resting;

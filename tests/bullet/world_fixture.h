@@ -26,10 +26,6 @@ class RecordingPredictor : public GravityPredictor {
   int calls = 0;
 };
 
-inline bullet::FIGNetWorldOptions network_alone() {
-  return bullet::FIGNetWorldOptions::network_alone();
-}
-
 struct WorldFixture {
   explicit WorldFixture(std::unique_ptr<AccelerationPredictor> predictor, GraphConfig graph = {},
                         const bullet::FIGNetWorldOptions& options = {})
