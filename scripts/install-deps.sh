@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config clang-format
   libbullet-dev libbullet-extras-dev
-  libeigen3-dev
+  libeigen3-dev libdnnl-dev
   liburdfdom-dev libtinyxml-dev libconsole-bridge-dev
   libassimp-dev assimp-testmodels
   libhdf5-dev

@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "fignet/error.h"
+#include "fignet/nn/gemm.h"
 #include "process_group.h"
 #ifdef FIGNET_WITH_MPI
 #include "fignet/parallel/mpi_collective.h"
@@ -30,6 +31,7 @@ void add_info_command(CLI::App& app) {
 #else
     std::printf("target: portable\n");
 #endif
+    std::printf("matrix products: %s\n", fignet::gemm_description().c_str());
   });
 }
 

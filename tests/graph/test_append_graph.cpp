@@ -1,6 +1,8 @@
-// append_graph: a batch built in parts and appended equals the batch built at once, field by field.
+// append_graph: a batch built in parts and appended equals the batch built at once, field by field;
+// extract_scenes, its inverse, gives back the parts.
 #include <gtest/gtest.h>
 
+#include "../error_text.h"
 #include "fignet/error.h"
 #include "fignet/graph/graph_builder.h"
 #include "scene_fixtures.h"
@@ -14,17 +16,42 @@ void expect_same_edges(const EdgeSet& a, const EdgeSet& b) {
   EXPECT_EQ(a.features.matrix(), b.features.matrix());
 }
 
-class AppendGraph : public ::testing::TestWithParam<CollisionEdges> {};
+void expect_same_graph(const Graph& a, const Graph& b) {
+  EXPECT_EQ(a.mesh_nodes.matrix(), b.mesh_nodes.matrix());
+  EXPECT_EQ(a.object_nodes.matrix(), b.object_nodes.matrix());
+  expect_same_edges(a.mesh_edges, b.mesh_edges);
+  expect_same_edges(a.object_to_mesh, b.object_to_mesh);
+  expect_same_edges(a.mesh_to_object, b.mesh_to_object);
+  expect_same_edges(a.world_edges, b.world_edges);
+  EXPECT_EQ(a.face_edges.senders, b.face_edges.senders);
+  EXPECT_EQ(a.face_edges.receivers, b.face_edges.receivers);
+  EXPECT_EQ(a.face_edges.features.matrix(), b.face_edges.features.matrix());
+  EXPECT_EQ(a.node_object, b.node_object);
+  EXPECT_EQ(a.node_kinematic, b.node_kinematic);
+  EXPECT_EQ(a.object_first_node, b.object_first_node);
+  EXPECT_EQ(a.object_kinematic, b.object_kinematic);
+  EXPECT_EQ(a.scene_first_object, b.scene_first_object);
+}
 
-TEST_P(AppendGraph, PartsAppendedEqualTheWholeBatch) {
+class AppendGraph : public ::testing::TestWithParam<CollisionEdges> {
+ protected:
+  // `count` random scenes of first_objects, first_objects + 1, ... objects.
+  void make_scenes(int count, unsigned first_seed, int first_objects) {
+    config.collisions = GetParam();
+    config.collision_radius = 0.3;
+    for (int s = 0; s < count; ++s) {
+      owned.push_back(testing::make_random_scene(first_seed + s, first_objects + s, 0.4));
+    }
+    for (const auto& r : owned) scenes.push_back(r.scene);
+  }
+
   GraphConfig config;
-  config.collisions = GetParam();
-  config.collision_radius = 0.3;
   std::vector<testing::RandomScene> owned;
   std::vector<Scene> scenes;
-  for (unsigned s = 0; s < 5; ++s) owned.push_back(testing::make_random_scene(s + 1, 3 + s, 0.4));
-  for (const auto& r : owned) scenes.push_back(r.scene);
+};
 
+TEST_P(AppendGraph, PartsAppendedEqualTheWholeBatch) {
+  make_scenes(5, 1, 3);
   GraphBuilder builder(config);
   Graph whole, parts, tail;
   builder.build(scenes, whole);
@@ -36,24 +63,50 @@ TEST_P(AppendGraph, PartsAppendedEqualTheWholeBatch) {
   builder.build(std::span(scenes).subspan(2), tail);
   append_graph(tail, parts);
 
-  EXPECT_EQ(parts.mesh_nodes.matrix(), whole.mesh_nodes.matrix());
-  EXPECT_EQ(parts.object_nodes.matrix(), whole.object_nodes.matrix());
-  expect_same_edges(parts.mesh_edges, whole.mesh_edges);
-  expect_same_edges(parts.object_to_mesh, whole.object_to_mesh);
-  expect_same_edges(parts.mesh_to_object, whole.mesh_to_object);
-  expect_same_edges(parts.world_edges, whole.world_edges);
-  EXPECT_EQ(parts.face_edges.senders, whole.face_edges.senders);
-  EXPECT_EQ(parts.face_edges.receivers, whole.face_edges.receivers);
-  EXPECT_EQ(parts.face_edges.features.matrix(), whole.face_edges.features.matrix());
-  EXPECT_EQ(parts.node_object, whole.node_object);
-  EXPECT_EQ(parts.node_kinematic, whole.node_kinematic);
-  EXPECT_EQ(parts.object_first_node, whole.object_first_node);
-  EXPECT_EQ(parts.object_kinematic, whole.object_kinematic);
-  EXPECT_EQ(parts.scene_first_object, whole.scene_first_object);
+  expect_same_graph(parts, whole);
+}
+
+// Split at any bounds, each part equals its scenes built alone.
+TEST_P(AppendGraph, SplitPartsEqualTheirScenesBuiltAlone) {
+  make_scenes(4, 7, 2);
+  GraphBuilder builder(config);
+  Graph whole, alone;
+  builder.build(scenes, whole);
+  std::vector<Graph> parts;
+  for (const std::vector<int>& bounds :
+       {std::vector<int>{0, 4}, {0, 1, 2, 3, 4}, {0, 3, 4}, {0, 1, 4}, {0, 2, 3, 4}}) {
+    split_scenes(whole, bounds, parts);
+    ASSERT_EQ(parts.size(), bounds.size() - 1);
+    for (size_t p = 0; p + 1 < bounds.size(); ++p) {
+      SCOPED_TRACE(::testing::Message() << "scenes [" << bounds[p] << ", " << bounds[p + 1] << ")");
+      builder.build(std::span(scenes).subspan(bounds[p], bounds[p + 1] - bounds[p]), alone);
+      expect_same_graph(parts[p], alone);
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Collisions, AppendGraph,
                          ::testing::Values(CollisionEdges::kFaceFace, CollisionEdges::kNodeNode));
+
+TEST(SplitScenes, RejectsBadBoundsAndEdgesBetweenParts) {
+  std::vector<testing::RandomScene> owned;
+  std::vector<Scene> scenes;
+  for (unsigned s = 0; s < 3; ++s) owned.push_back(testing::make_random_scene(s + 1, 3, 0.4));
+  for (const auto& r : owned) scenes.push_back(r.scene);
+  Graph whole;
+  GraphBuilder(GraphConfig{}).build(scenes, whole);
+  std::vector<Graph> parts;
+  for (const std::vector<int>& bounds :
+       {std::vector<int>{0, 4}, {1, 3}, {0, 2, 2, 3}, {0}, {0, 2, 1, 3}}) {
+    EXPECT_THROW(split_scenes(whole, bounds, parts), ConfigError);
+  }
+  // An edge from scene 0 to scene 2 cannot be dealt to one part.
+  whole.mesh_edges.senders.front() = whole.num_mesh_nodes() - 1;
+  EXPECT_EQ(testing::error_of([&] {
+              split_scenes(whole, std::vector<int>{0, 1, 3}, parts);
+            }),
+            "split_scenes: mesh edge 0 joins two parts");
+}
 
 TEST(AppendGraph, RejectsGraphsOfOtherFeatureWidths) {
   GraphConfig face, node;

@@ -1,5 +1,6 @@
 #include "fignet/model/network.h"
 
+#include "fignet/nn/gemm.h"
 #include "fignet/nn/ops.h"
 
 namespace fignet {
@@ -217,7 +218,8 @@ ConstMatrixView Network::forward(const float* params, const Normalizers& normali
       const EdgeSet& edges = edges_of(graph, t);
       const Mlp& mlp = step.edges[t];
       MatrixView z = ws.first.view(edges.size(), l);
-      z.noalias() = cur.edges[t].get() * mlp.first_weight(params, 0);
+      gemm(cur.edges[t].get(), Transpose::kNo, mlp.first_weight(params, 0), Transpose::kNo, z,
+           false);
       add_gathered_product(node_latents(cur, sender_set(t)).get(), mlp.first_weight(params, 1),
                            span_of(edges.senders), z, ws.scratch);
       add_gathered_product(node_latents(cur, receiver_set(t)).get(), mlp.first_weight(params, 2),
@@ -244,7 +246,8 @@ ConstMatrixView Network::forward(const float* params, const Normalizers& normali
     // Node updates: [v, Σ incoming latents per edge type] with residuals.
     auto update_nodes = [&](NodeSet set, const Mlp& mlp, MlpCache& cache, Eigen::Index count) {
       MatrixView z = ws.first.view(count, l);
-      z.noalias() = node_latents(cur, set).get() * mlp.first_weight(params, 0);
+      gemm(node_latents(cur, set).get(), Transpose::kNo, mlp.first_weight(params, 0),
+           Transpose::kNo, z, false);
       int block = 1;
       for (int t = 0; t < kinds; ++t) {
         if (receiver_set(t) != set) continue;

@@ -1,5 +1,7 @@
 #include "fignet/nn/ops.h"
 
+#include "fignet/nn/gemm.h"
+
 namespace fignet {
 
 void gather_add(const ConstMatrixRef& src, IndexSpan index, MatrixRef out) {
@@ -11,22 +13,22 @@ void scatter_add(const ConstMatrixRef& src, IndexSpan index, MatrixRef out) {
 }
 
 void add_product(const ConstMatrixRef& x, const ConstMatrixRef& w, MatrixRef z) {
-  if (x.rows() > 0) z.noalias() += x * w;
+  gemm(x, Transpose::kNo, w, Transpose::kNo, z, /*accumulate=*/true);
 }
 
 void add_gathered_product(const ConstMatrixRef& x, const ConstMatrixRef& w, IndexSpan index,
                           MatrixRef z, Buffer& scratch) {
   if (index.count == 0) return;
   MatrixView per_node = scratch.view(x.rows(), w.cols());
-  per_node.noalias() = x * w;
+  gemm(x, Transpose::kNo, w, Transpose::kNo, per_node, /*accumulate=*/false);
   gather_add(per_node, index, z);
 }
 
 void backprop_product(const ConstMatrixRef& x, const ConstMatrixRef& w, const ConstMatrixRef& dz,
                       MatrixRef dw, MatrixRef* dx) {
   if (x.rows() == 0) return;
-  dw.noalias() += x.transpose() * dz;
-  if (dx) dx->noalias() += dz * w.transpose();
+  gemm(x, Transpose::kYes, dz, Transpose::kNo, dw, /*accumulate=*/true);
+  if (dx) gemm(dz, Transpose::kNo, w, Transpose::kYes, *dx, /*accumulate=*/true);
 }
 
 void backprop_gathered_product(const ConstMatrixRef& x, const ConstMatrixRef& w, IndexSpan index,
@@ -35,8 +37,8 @@ void backprop_gathered_product(const ConstMatrixRef& x, const ConstMatrixRef& w,
   if (index.count == 0) return;
   MatrixView per_node = scratch.zeros(x.rows(), w.cols());
   scatter_add(dz, index, per_node);
-  dw.noalias() += x.transpose() * per_node;
-  if (dx) dx->noalias() += per_node * w.transpose();
+  gemm(x, Transpose::kYes, per_node, Transpose::kNo, dw, /*accumulate=*/true);
+  if (dx) gemm(per_node, Transpose::kNo, w, Transpose::kYes, *dx, /*accumulate=*/true);
 }
 
 }  // namespace fignet

@@ -202,10 +202,13 @@ void Trainer::accumulate_statistics() {
 }
 
 double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
-  const ConstMatrixView output =
-      backend_->forward(params_.data(), normalizers_, graph_, with_gradient);
   normalized_targets_.resize(targets_.rows(), 3);
   normalizers_.target.normalize(targets_, normalized_targets_);
+  // The mean is over every process's dynamic nodes, counted before the network runs so that
+  // each chunk of the batch can take its gradient as soon as its output exists.
+  double count = static_cast<double>(std::count(in_loss_.begin(), in_loss_.end(), 1));
+  if (reduce) collective_->sum(std::span<double>(&count, 1));
+  if (count == 0) return 0.0;
   // Squared error, or Huber's: quadratic within delta, linear beyond (scaled to match at 0).
   const double delta = trainer_config_.huber_delta;
   auto loss_of = [delta](double error) {
@@ -215,32 +218,40 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
   auto slope_of = [delta](double error) {
     return delta <= 0.0 || std::abs(error) <= delta ? error : std::copysign(delta, error);
   };
-  double local_squares = 0.0;
-  for (Eigen::Index i = 0; i < output.rows(); ++i) {
-    if (!in_loss_[i]) continue;
-    for (int c = 0; c < 3; ++c) local_squares += loss_of(output(i, c) - normalized_targets_(i, c));
-  }
-  // The mean is over every process's dynamic nodes: one small sum for the count and loss.
-  double totals[2] = {static_cast<double>(std::count(in_loss_.begin(), in_loss_.end(), 1)),
-                      local_squares};
-  if (reduce) collective_->sum(totals);
-  const double count = totals[0];
-  if (count == 0) return 0.0;
-  if (with_gradient) {
-    d_output_.setZero(output.rows(), 3);
-    const float scale = 2.0f / static_cast<float>(3 * count);
-    for (Eigen::Index i = 0; i < output.rows(); ++i) {
+  const float scale = 2.0f / static_cast<float>(3 * count);
+  // The loss of the output rows of nodes [first, first + rows), and its gradient when asked.
+  auto node_loss = [&](int first, const ConstMatrixRef& output, MatrixRef* d_output) {
+    double squares = 0.0;
+    if (d_output) d_output->setZero();
+    for (Eigen::Index r = 0; r < output.rows(); ++r) {
+      const Eigen::Index i = first + r;
       if (!in_loss_[i]) continue;
-      for (int c = 0; c < 3; ++c)
-        d_output_(i, c) = scale * slope_of(output(i, c) - normalized_targets_(i, c));
+      for (int c = 0; c < 3; ++c) {
+        const double error = output(r, c) - normalized_targets_(i, c);
+        squares += loss_of(error);
+        if (d_output) (*d_output)(r, c) = scale * slope_of(error);
+      }
     }
+    return squares;
+  };
+  double squares = 0.0;
+  if (with_gradient) {
     std::fill(grads_.begin(), grads_.end(), 0.0f);
-    backend_->backward(params_.data(), grads_.data(), graph_, d_output_);
+    squares = backend_->forward_backward(
+        params_.data(), normalizers_, graph_, grads_.data(),
+        [&](int first, const ConstMatrixRef& output, MatrixRef d_output) {
+          return node_loss(first, output, &d_output);
+        });
+  } else {
+    squares = node_loss(0, backend_->forward(params_.data(), normalizers_, graph_, false), nullptr);
+  }
+  if (reduce) collective_->sum(std::span<double>(&squares, 1));
+  if (with_gradient) {
     // Each process's gradient is its part of the global mean's: their sum is the whole.
     if (reduce) collective_->sum(std::span<float>(grads_.data(), grads_.size()));
     clip_gradient();
   }
-  return totals[1] / (3 * count);
+  return squares / (3 * count);
 }
 
 std::uint64_t Trainer::draw_batch(std::int64_t counter, std::vector<SampleRef>& batch) const {

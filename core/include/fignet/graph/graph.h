@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "fignet/geometry/types.h"
@@ -85,5 +86,11 @@ struct Graph {
 // one graph equals building A, building B, and appending B's graph (so batches can be built by
 // several threads). Throws ConfigError when their feature widths differ.
 void append_graph(const Graph& part, Graph& whole);
+
+// Splits `whole` into parts of consecutive scenes, the inverse of append_graph: part i holds
+// scenes [bounds[i], bounds[i + 1]) with indices relative to it, edges in the whole's order.
+// Throws ConfigError when the bounds are not increasing within [0, whole.num_scenes()], or an
+// edge joins two parts.
+void split_scenes(const Graph& whole, std::span<const int> bounds, std::vector<Graph>& parts);
 
 }  // namespace fignet

@@ -4,12 +4,20 @@
 // where the work was done: inputs and outputs are host memory.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 
 #include "fignet/model/network.h"
 
 namespace fignet {
+
+// The loss over the network's output for mesh nodes [first_node, first_node + output.rows()):
+// writes d(loss)/d(output) for those rows into d_output and returns their part of the loss.
+// Called once per chunk of the graph, possibly from several threads at once (for disjoint
+// rows), so it must only read shared state.
+using LossGradient =
+    std::function<double(int first_node, const ConstMatrixRef& output, MatrixRef d_output)>;
 
 class NetworkBackend {
  public:
@@ -22,11 +30,21 @@ class NetworkBackend {
   // As Network::backward: accumulates d(loss)/d(params) into the host array `grads`.
   virtual void backward(const float* params, float* grads, const Graph& graph,
                         const ConstMatrixRef& d_output) = 0;
+  // One training pass: forward, the loss's gradient from `loss`, backward. Accumulates
+  // d(loss)/d(params) into `grads` and returns the loss (the sum of `loss`'s returns, in node
+  // order). The default runs forward() over the whole graph, then backward(); the CPU backend
+  // runs a batch as chunks of whole scenes, forward and backward one chunk after another, so
+  // that only a few chunks' activations exist at once.
+  virtual double forward_backward(const float* params, const Normalizers& normalizers,
+                                  const Graph& graph, float* grads, const LossGradient& loss);
   // Backends that keep their own copy of the parameters re-read them after this call (the
   // parameters a backend was last given are otherwise assumed unchanged at the same address).
   virtual void parameters_changed() {}
   // Where the time of the calls so far went, for backends that measure it ("" otherwise).
   virtual std::string profile() const { return {}; }
+
+ private:
+  Buffer d_output_;  // forward_backward's default: d(loss)/d(output) of the whole graph
 };
 
 // Network::forward and backward with a workspace of their own; `network` must outlive it.

@@ -144,7 +144,7 @@ class Trainer {
   Graph graph_;
   std::vector<Scene> scenes_;
   std::vector<Points> scene_targets_;
-  RowMatrixXf targets_, normalized_targets_, d_output_;
+  RowMatrixXf targets_, normalized_targets_;
   std::vector<std::uint8_t> in_loss_;
   Normalizers batch_statistics_;
   std::vector<double> statistics_buffer_;

@@ -1,0 +1,40 @@
+// The network's matrix products, C = op(A)·op(B) or C += op(A)·op(B), on row-major float matrices
+// (column blocks of wider ones included). Every product of the forward and backward passes goes
+// through gemm(), so the engine that runs them is chosen in one place:
+//   - oneDNN (builds with FIGNET_WITH_ONEDNN, the default where libdnnl-dev is found): its kernels
+//     are compiled at run time for the processor's instruction set (AVX2, AVX-512, ...);
+//   - Eigen: compiled for the build's target (x86-64-v3, or baseline x86-64 in the portable
+//     preset); the fallback of a build without oneDNN.
+// Both use the threads Eigen::nbThreads() gives (Eigen::setNbThreads, OpenMP's default otherwise)
+// and run single-threaded inside an OpenMP parallel region. Results of one engine are
+// deterministic for a given shape, thread count and processor.
+#pragma once
+
+#include <string>
+
+#include "fignet/nn/buffer.h"
+
+namespace fignet {
+
+enum class GemmEngine { kEigen, kOneDnn };
+enum class Transpose { kNo, kYes };
+
+// c = op_a(a)·op_b(b), or c += op_a(a)·op_b(b) when `accumulate`. Shapes must agree (checked in
+// debug builds); an empty inner dimension gives zeros (or leaves c unchanged when accumulating).
+void gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b, Transpose op_b,
+          MatrixRef c, bool accumulate);
+
+// The engine gemm() uses: oneDNN where the build has it, unless the environment variable
+// FIGNET_GEMM=eigen (read once, at the first product) or set_gemm_engine() chose Eigen.
+GemmEngine gemm_engine();
+// Process-wide; throws ConfigError when the build lacks the engine.
+void set_gemm_engine(GemmEngine engine);
+bool gemm_engine_available(GemmEngine engine);
+// "oneDNN" or "Eigen".
+const char* gemm_engine_name(GemmEngine engine);
+// What runs the products, for `fignet info` and benchmark reports, e.g. "oneDNN 2.6.3, kernels
+// for avx512_core_bf16 (chosen at run time)" or "Eigen 3.4.0, AVX SSE2 ... (fixed at compile
+// time)".
+std::string gemm_description();
+
+}  // namespace fignet

@@ -1,0 +1,152 @@
+// The CPU backend runs a batch as chunks of whole scenes, in parallel: its outputs and gradients
+// must be the whole graph's (to float rounding), and must not depend on the thread count. Also:
+// the network through either product engine gives the same results to float tolerance.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "fignet/graph/graph_builder.h"
+#include "fignet/model/network_backend.h"
+#include "fignet/nn/gemm.h"
+#include "fignet/scenes/resting_lattice.h"
+
+namespace fignet {
+namespace {
+
+// Eight MOVi-A-like scenes of six objects (~3,000 mesh nodes: several chunks), a small-preset
+// network with random parameters, and normalisers from the batch.
+struct Batch {
+  std::vector<RestingLattice> lattices;
+  Graph graph;
+  Network network{ModelConfig::preset_named("small")};
+  std::vector<float> params;
+  Normalizers normalizers;
+  RowMatrixXf weights;  // the loss is Σ weights·output
+
+  Batch() {
+    std::vector<Scene> scenes;
+    for (unsigned s = 0; s < 8; ++s) {
+      RestingLatticeOptions options;
+      options.objects = 6;
+      options.seed = s + 1;
+      options.scales = {0.7, 1.4};
+      lattices.push_back(make_resting_lattice(options));
+    }
+    for (const auto& l : lattices) scenes.push_back(l.scene);
+    GraphBuilder(network.config().graph).build(scenes, graph);
+    network.layout().initialize(params, 5);
+    normalizers = network.make_normalizers();
+    network.accumulate_input_statistics(graph, normalizers);
+    std::mt19937 rng(3);
+    std::normal_distribution<float> n;
+    weights.resize(graph.num_mesh_nodes(), 3);
+    for (Eigen::Index i = 0; i < weights.size(); ++i) weights.data()[i] = n(rng);
+  }
+
+  LossGradient loss() const {
+    return [this](int first, const ConstMatrixRef& output, MatrixRef d_output) {
+      d_output = weights.middleRows(first, output.rows());
+      return static_cast<double>(
+          (output.array() * weights.middleRows(first, output.rows()).array()).sum());
+    };
+  }
+};
+
+// Runs f with Eigen::nbThreads() == threads.
+template <class F>
+auto with_threads(int threads, F&& f) {
+  Eigen::setNbThreads(threads);
+  auto result = f();
+  Eigen::setNbThreads(0);
+  return result;
+}
+
+double max_abs(const std::vector<float>& a) {
+  double m = 0.0;
+  for (float x : a) m = std::max(m, static_cast<double>(std::abs(x)));
+  return m;
+}
+
+double max_difference(const std::vector<float>& a, const std::vector<float>& b) {
+  double m = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) m = std::max(m, static_cast<double>(std::abs(a[i] - b[i])));
+  return m;
+}
+
+TEST(CpuBackend, ChunkedOutputsAndGradientsEqualTheWholeGraphs) {
+  const Batch batch;
+  ASSERT_GT(batch.graph.num_mesh_nodes(), 2500);
+  // The whole graph in one piece.
+  NetworkWorkspace workspace;
+  const RowMatrixXf whole_output =
+      batch.network.forward(batch.params.data(), batch.normalizers, batch.graph, workspace, true);
+  std::vector<float> whole_grads(batch.params.size(), 0.0f);
+  batch.network.backward(batch.params.data(), whole_grads.data(), batch.graph, batch.weights,
+                         workspace);
+  // The backend, in chunks.
+  auto backend = make_cpu_backend(batch.network);
+  const RowMatrixXf output =
+      backend->forward(batch.params.data(), batch.normalizers, batch.graph, false);
+  EXPECT_LT((output - whole_output).cwiseAbs().maxCoeff(), 1e-4);
+  std::vector<float> grads(batch.params.size(), 0.0f);
+  const double loss = backend->forward_backward(batch.params.data(), batch.normalizers, batch.graph,
+                                                grads.data(), batch.loss());
+  const double whole_loss = (whole_output.array() * batch.weights.array()).sum();
+  EXPECT_NEAR(loss, whole_loss, 1e-4 * std::abs(whole_loss) + 1e-3);
+  EXPECT_LT(max_difference(grads, whole_grads), 1e-4 * max_abs(whole_grads));
+}
+
+TEST(CpuBackend, ResultsDoNotDependOnTheThreadCount) {
+  const Batch batch;
+  struct Result {
+    RowMatrixXf output;
+    std::vector<float> grads, split_grads;
+    double loss = 0.0;
+  };
+  auto run = [&](int threads) {
+    return with_threads(threads, [&] {
+      auto backend = make_cpu_backend(batch.network);
+      Result r;
+      r.output = backend->forward(batch.params.data(), batch.normalizers, batch.graph, false);
+      r.grads.assign(batch.params.size(), 0.0f);
+      r.loss = backend->forward_backward(batch.params.data(), batch.normalizers, batch.graph,
+                                         r.grads.data(), batch.loss());
+      // forward(keep) then backward: the same chunks and lanes, the same sums.
+      backend->forward(batch.params.data(), batch.normalizers, batch.graph, true);
+      r.split_grads.assign(batch.params.size(), 0.0f);
+      backend->backward(batch.params.data(), r.split_grads.data(), batch.graph, batch.weights);
+      return r;
+    });
+  };
+  const Result one = run(1), two = run(2), four = run(4);
+  for (const Result* other : {&two, &four}) {
+    EXPECT_EQ(other->output, one.output);
+    EXPECT_EQ(other->grads, one.grads);
+    EXPECT_EQ(other->loss, one.loss);
+  }
+  EXPECT_EQ(one.split_grads, one.grads);
+}
+
+// The network's products through Eigen and through oneDNN agree to float tolerance.
+TEST(CpuBackend, ProductEnginesAgree) {
+  if (!gemm_engine_available(GemmEngine::kOneDnn)) GTEST_SKIP() << "this build has no oneDNN";
+  const Batch batch;
+  const GemmEngine previous = gemm_engine();
+  auto run = [&](GemmEngine engine) {
+    set_gemm_engine(engine);
+    NetworkWorkspace workspace;
+    RowMatrixXf output =
+        batch.network.forward(batch.params.data(), batch.normalizers, batch.graph, workspace, true);
+    std::vector<float> grads(batch.params.size(), 0.0f);
+    batch.network.backward(batch.params.data(), grads.data(), batch.graph, batch.weights,
+                           workspace);
+    return std::pair(output, grads);
+  };
+  const auto eigen = run(GemmEngine::kEigen), onednn = run(GemmEngine::kOneDnn);
+  set_gemm_engine(previous);
+  EXPECT_LT((eigen.first - onednn.first).cwiseAbs().maxCoeff(), 1e-4);
+  EXPECT_LT(max_difference(eigen.second, onednn.second), 1e-4 * max_abs(eigen.second));
+}
+
+}  // namespace
+}  // namespace fignet

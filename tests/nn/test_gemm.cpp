@@ -1,0 +1,116 @@
+// gemm() against a double-precision product, for every engine the build has, every transpose,
+// assignment and accumulation, column blocks of wider matrices and empty dimensions.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "fignet/error.h"
+#include "fignet/nn/gemm.h"
+
+namespace fignet {
+namespace {
+
+using MatrixXdRow = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+RowMatrixXf random_matrix(Eigen::Index rows, Eigen::Index cols, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  RowMatrixXf m(rows, cols);
+  for (Eigen::Index i = 0; i < m.size(); ++i) m.data()[i] = u(rng);
+  return m;
+}
+
+// Restores the engine a test changed.
+class EngineScope {
+ public:
+  explicit EngineScope(GemmEngine engine) : previous_(gemm_engine()) { set_gemm_engine(engine); }
+  ~EngineScope() { set_gemm_engine(previous_); }
+
+ private:
+  GemmEngine previous_;
+};
+
+class Gemm : public ::testing::TestWithParam<GemmEngine> {
+ protected:
+  void SetUp() override {
+    if (!gemm_engine_available(GetParam())) GTEST_SKIP() << "this build has no oneDNN";
+  }
+};
+
+TEST_P(Gemm, MatchesADoublePrecisionProductForEveryTransposeAndShape) {
+  const EngineScope scope(GetParam());
+  // Shapes of the network (thin and wide, K from 3 to hundreds) and odd sizes.
+  const int shapes[][3] = {{1, 1, 1}, {7, 5, 3}, {400, 64, 64}, {33, 192, 64}, {64, 1000, 3}};
+  unsigned seed = 1;
+  for (const auto& shape : shapes) {
+    const int m = shape[0], k = shape[1], n = shape[2];
+    for (Transpose ta : {Transpose::kNo, Transpose::kYes}) {
+      for (Transpose tb : {Transpose::kNo, Transpose::kYes}) {
+        for (bool accumulate : {false, true}) {
+          SCOPED_TRACE(::testing::Message()
+                       << m << "x" << k << "x" << n << " ta " << (ta == Transpose::kYes) << " tb "
+                       << (tb == Transpose::kYes) << " acc " << accumulate);
+          const RowMatrixXf a =
+              ta == Transpose::kNo ? random_matrix(m, k, seed++) : random_matrix(k, m, seed++);
+          const RowMatrixXf b =
+              tb == Transpose::kNo ? random_matrix(k, n, seed++) : random_matrix(n, k, seed++);
+          RowMatrixXf c = random_matrix(m, n, seed++);
+          const MatrixXdRow a_op = ta == Transpose::kNo ? MatrixXdRow(a.cast<double>())
+                                                        : MatrixXdRow(a.cast<double>().transpose());
+          const MatrixXdRow b_op = tb == Transpose::kNo ? MatrixXdRow(b.cast<double>())
+                                                        : MatrixXdRow(b.cast<double>().transpose());
+          const MatrixXdRow expected =
+              (accumulate ? MatrixXdRow(c.cast<double>()) : MatrixXdRow::Zero(m, n)) + a_op * b_op;
+          gemm(a, ta, b, tb, c, accumulate);
+          // float32 accumulation over k terms of size <= 1: error grows like sqrt(k)·eps.
+          EXPECT_LT((c.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-5 * (k + 10));
+        }
+      }
+    }
+  }
+}
+
+TEST_P(Gemm, WorksOnColumnBlocksOfWiderMatrices) {
+  const EngineScope scope(GetParam());
+  // The face-edge latents are [q0 q1 q2], three column blocks of one 3L-wide matrix.
+  const RowMatrixXf wide_a = random_matrix(50, 3 * 16, 1), b = random_matrix(16, 8, 2);
+  RowMatrixXf wide_c = random_matrix(50, 3 * 8, 3);
+  const RowMatrixXf before = wide_c;
+  gemm(wide_a.middleCols(16, 16), Transpose::kNo, b, Transpose::kNo, wide_c.middleCols(8, 8), true);
+  const RowMatrixXf expected = before.middleCols(8, 8) + wide_a.middleCols(16, 16) * b;
+  EXPECT_LT((wide_c.middleCols(8, 8) - expected).cwiseAbs().maxCoeff(), 1e-5);
+  // Columns outside the block are untouched.
+  EXPECT_EQ(wide_c.leftCols(8), before.leftCols(8));
+  EXPECT_EQ(wide_c.rightCols(8), before.rightCols(8));
+}
+
+TEST_P(Gemm, EmptyInnerDimensionGivesZerosOrLeavesTheSum) {
+  const EngineScope scope(GetParam());
+  const RowMatrixXf a(4, 0), b(0, 3);
+  RowMatrixXf c = random_matrix(4, 3, 1);
+  const RowMatrixXf before = c;
+  gemm(a, Transpose::kNo, b, Transpose::kNo, c, true);
+  EXPECT_EQ(c, before);
+  gemm(a, Transpose::kNo, b, Transpose::kNo, c, false);
+  EXPECT_EQ(c, RowMatrixXf::Zero(4, 3));
+  RowMatrixXf empty(0, 3);
+  gemm(RowMatrixXf(0, 5), Transpose::kNo, random_matrix(5, 3, 2), Transpose::kNo, empty, false);
+}
+
+INSTANTIATE_TEST_SUITE_P(Engines, Gemm, ::testing::Values(GemmEngine::kEigen, GemmEngine::kOneDnn),
+                         [](const auto& info) { return gemm_engine_name(info.param); });
+
+TEST(GemmEngine, EigenIsAlwaysThereAndTheDescriptionNamesTheEngine) {
+  EXPECT_TRUE(gemm_engine_available(GemmEngine::kEigen));
+  const EngineScope scope(GemmEngine::kEigen);
+  EXPECT_EQ(gemm_description().rfind("Eigen ", 0), 0u) << gemm_description();
+  if (gemm_engine_available(GemmEngine::kOneDnn)) {
+    set_gemm_engine(GemmEngine::kOneDnn);
+    EXPECT_EQ(gemm_description().rfind("oneDNN ", 0), 0u) << gemm_description();
+  } else {
+    EXPECT_THROW(set_gemm_engine(GemmEngine::kOneDnn), ConfigError);
+  }
+}
+
+}  // namespace
+}  // namespace fignet
