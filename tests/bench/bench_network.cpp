@@ -1,38 +1,118 @@
-// FIGNet inference and training steps on a 6-object MOVi-A-like scene (~400 mesh nodes), for the
-// "paper" and "small" presets, with 1 and 2 threads. Each benchmark also times a plain Eigen SGEMM
-// of the network's dominant shape (mesh edges x L times L x L) in the same run and reports
-//   gflops        achieved by the network (FLOPs counted by Network::forward_flops)
-//   sgemm_gflops  achieved by the reference SGEMM just before
-//   ratio         gflops / sgemm_gflops (aim: >= 0.5 for inference)
+// FIGNet inference and training on MOVi-A-like scenes (~380 mesh nodes each), for the "paper"
+// and "small" presets, with 1 and 2 threads. Every figure is set against references measured in
+// the same run:
+//   gflops         achieved by the network (FLOPs counted by Network::forward_flops; a
+//                  training step counts 3x the forward)
+//   sgemm_gflops   oneDNN's SGEMM (Eigen's without oneDNN) on the network's dominant shape,
+//                  mesh edges x L times L x L, with the same threads; ratio = gflops / that
+//   eigen_gflops   Eigen's SGEMM on the same shape (the products' engine before oneDNN)
+//   peak_gflops    the processor's fp32 peak: independent FMA chains on the widest vectors it
+//                  has (AVX-512 or AVX2, chosen at run time) on every thread; of_peak = gflops /
+//                  peak
+// BM_TrainingBatch trains on a batch of 16 scenes as `fignet train` does and reports samples/s:
+// "whole_eigen" is the path before the CPU backend work (the batch as one graph, Eigen products
+// threaded one by one), "chunked" the CPU backend (chunks of scenes in parallel, the build's
+// product engine).
 //
 //   build/release/tests/bench/bench_network
 #include <benchmark/benchmark.h>
+#include <immintrin.h>
+#include <omp.h>
 
 #include <Eigen/Core>
 #include <chrono>
 
 #include "fignet/graph/graph_builder.h"
 #include "fignet/model/model.h"
+#include "fignet/model/network_backend.h"
+#include "fignet/nn/gemm.h"
 #include "fignet/scenes/resting_lattice.h"
 #include "fignet/train/training_batch.h"
 
 namespace fignet {
 namespace {
 
-// GFLOP/s of an (rows x l) * (l x l) single-precision product, measured for ~0.2 s.
-double sgemm_gflops(Eigen::Index rows, Eigen::Index l) {
-  const RowMatrixXf a = RowMatrixXf::Random(rows, l), b = RowMatrixXf::Random(l, l);
-  RowMatrixXf c(rows, l);
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// GFLOP/s of f, which does `flops` per call, measured for ~0.2 s.
+template <class F>
+double gflops_of(F&& f, double flops) {
   int reps = 0;
   const auto start = std::chrono::steady_clock::now();
   double seconds = 0;
   do {
-    c.noalias() = a * b;
-    benchmark::DoNotOptimize(c.data());
+    f();
     ++reps;
-    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    seconds = seconds_since(start);
   } while (seconds < 0.2);
-  return 2.0 * rows * l * l * reps / seconds / 1e9;
+  return flops * reps / seconds / 1e9;
+}
+
+// GFLOP/s of an (rows x l) * (l x l) product through gemm() with the given engine.
+double sgemm_gflops(Eigen::Index rows, Eigen::Index l, GemmEngine engine) {
+  const GemmEngine previous = gemm_engine();
+  set_gemm_engine(engine);
+  const RowMatrixXf a = RowMatrixXf::Random(rows, l), b = RowMatrixXf::Random(l, l);
+  RowMatrixXf c(rows, l);
+  const double rate = gflops_of(
+      [&] {
+        gemm(a, Transpose::kNo, b, Transpose::kNo, c, false);
+        benchmark::DoNotOptimize(c.data());
+      },
+      2.0 * rows * l * l);
+  set_gemm_engine(previous);
+  return rate;
+}
+
+// Independent FMA chains (more than latency x units) on 8 or 16 floats: the core's fp32 peak.
+constexpr int kChains = 12;
+constexpr long kFmaIterations = 20'000'000;
+
+__attribute__((target("avx2,fma"))) double fma_seconds_avx2() {
+  __m256 acc[kChains];
+  for (int j = 0; j < kChains; ++j) acc[j] = _mm256_set1_ps(static_cast<float>(j));
+  const __m256 a = _mm256_set1_ps(0.999999f), b = _mm256_set1_ps(1e-7f);
+  const auto start = std::chrono::steady_clock::now();
+  for (long i = 0; i < kFmaIterations; ++i) {
+    for (int j = 0; j < kChains; ++j) acc[j] = _mm256_fmadd_ps(acc[j], a, b);
+  }
+  const double seconds = seconds_since(start);
+  for (int j = 1; j < kChains; ++j) acc[0] = _mm256_add_ps(acc[0], acc[j]);
+  benchmark::DoNotOptimize(acc[0]);
+  return seconds;
+}
+
+__attribute__((target("avx512f"))) double fma_seconds_avx512() {
+  __m512 acc[kChains];
+  for (int j = 0; j < kChains; ++j) acc[j] = _mm512_set1_ps(static_cast<float>(j));
+  const __m512 a = _mm512_set1_ps(0.999999f), b = _mm512_set1_ps(1e-7f);
+  const auto start = std::chrono::steady_clock::now();
+  for (long i = 0; i < kFmaIterations; ++i) {
+    for (int j = 0; j < kChains; ++j) acc[j] = _mm512_fmadd_ps(acc[j], a, b);
+  }
+  const double seconds = seconds_since(start);
+  for (int j = 1; j < kChains; ++j) acc[0] = _mm512_add_ps(acc[0], acc[j]);
+  benchmark::DoNotOptimize(acc[0]);
+  return seconds;
+}
+
+// The fp32 peak of `threads` cores in GFLOP/s: the better of AVX2 and AVX-512 where present
+// (some processors run AVX-512 at half width, so wider is not always faster).
+double peak_gflops(int threads) {
+  auto rate = [&](double (*kernel)(), int lanes) {
+    double total = 0.0;
+#pragma omp parallel num_threads(threads) reduction(+ : total)
+    total += 2.0 * lanes * kChains * kFmaIterations / kernel() / 1e9;
+    return total;
+  };
+  double peak = 0.0;
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+    peak = rate(fma_seconds_avx2, 8);
+  }
+  if (__builtin_cpu_supports("avx512f")) peak = std::max(peak, rate(fma_seconds_avx512, 16));
+  return peak;
 }
 
 struct Setup {
@@ -54,22 +134,27 @@ Setup make_setup(const char* preset) {
   return s;
 }
 
+// The same-run references of a figure of `achieved` GFLOP/s on `threads` threads.
+void add_references(benchmark::State& state, double achieved, Eigen::Index mesh_edges,
+                    Eigen::Index latent_size, int threads) {
+  const double sgemm = sgemm_gflops(mesh_edges, latent_size, gemm_engine());
+  const double peak = peak_gflops(threads);
+  state.counters["gflops"] = achieved;
+  state.counters["sgemm_gflops"] = sgemm;
+  state.counters["eigen_gflops"] = sgemm_gflops(mesh_edges, latent_size, GemmEngine::kEigen);
+  state.counters["peak_gflops"] = peak;
+  state.counters["ratio"] = achieved / sgemm;
+  state.counters["of_peak"] = achieved / peak;
+}
+
 void report(benchmark::State& state, const Setup& s, double flops_per_iteration,
-            double loop_seconds) {
-  const double l = s.model->config().latent_size;
+            double loop_seconds, int threads) {
   state.counters["mesh_nodes"] = s.graph.num_mesh_nodes();
   state.counters["face_edges"] = s.graph.face_edges.size();
   state.counters["gflop"] = flops_per_iteration / 1e9;
-  state.counters["gflops"] =
-      benchmark::Counter(flops_per_iteration / 1e9, benchmark::Counter::kIsIterationInvariantRate);
-  const double reference = sgemm_gflops(s.graph.mesh_edges.size(), static_cast<Eigen::Index>(l));
-  state.counters["sgemm_gflops"] = reference;
   const double achieved = flops_per_iteration * state.iterations() / loop_seconds / 1e9;
-  state.counters["ratio"] = achieved / reference;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  add_references(state, achieved, s.graph.mesh_edges.size(), s.model->config().latent_size,
+                 threads);
 }
 
 void BM_Inference(benchmark::State& state, const char* preset) {
@@ -85,7 +170,9 @@ void BM_Inference(benchmark::State& state, const char* preset) {
                                           s.graph, workspace, false)
                                  .data());
   }
-  report(state, s, network.forward_flops(s.graph), seconds_since(start));
+  report(state, s, network.forward_flops(s.graph), seconds_since(start),
+         static_cast<int>(state.range(0)));
+  Eigen::setNbThreads(0);
 }
 
 void BM_TrainingStep(benchmark::State& state, const char* preset) {
@@ -102,7 +189,65 @@ void BM_TrainingStep(benchmark::State& state, const char* preset) {
     network.backward(s.model->parameters().data(), grads.data(), s.graph, d_output, workspace);
     benchmark::DoNotOptimize(grads.data());
   }
-  report(state, s, 3.0 * network.forward_flops(s.graph), seconds_since(start));  // bwd ≈ 2 fwd
+  report(state, s, 3.0 * network.forward_flops(s.graph), seconds_since(start),  // bwd ≈ 2 fwd
+         static_cast<int>(state.range(0)));
+  Eigen::setNbThreads(0);
+}
+
+// A training batch of 16 scenes (different lattices), forward and backward, as `fignet train`
+// runs it: the batch as one graph with Eigen's products threaded one by one (before), or the CPU
+// backend's chunks in parallel with the build's engine (now).
+void BM_TrainingBatch(benchmark::State& state, const char* preset, bool chunked) {
+  const int threads = static_cast<int>(state.range(0));
+  constexpr int kScenes = 16;
+  std::vector<RestingLattice> lattices;
+  std::vector<Scene> scenes;
+  for (int i = 0; i < kScenes; ++i) {
+    RestingLatticeOptions options;
+    options.objects = 3 + i % 8;  // MOVi-A: 3 to 10 objects
+    options.seed = i + 1;
+    options.scales = {0.7, 1.4};
+    lattices.push_back(make_resting_lattice(options));
+  }
+  for (const auto& l : lattices) scenes.push_back(l.scene);
+  const Model model(ModelConfig::preset_named(preset));
+  const Network& network = model.network();
+  Graph graph;
+  GraphBuilder(model.config().graph).build(scenes, graph);
+  const RowMatrixXf d_output = RowMatrixXf::Ones(graph.num_mesh_nodes(), 3);
+  std::vector<float> grads(model.parameters().size());
+  const float* params = model.parameters().data();
+  const GemmEngine engine = gemm_engine();
+  if (!chunked) set_gemm_engine(GemmEngine::kEigen);
+  Eigen::setNbThreads(threads);
+  NetworkWorkspace workspace;
+  auto backend = make_cpu_backend(network);
+  const LossGradient loss = [&](int first, const ConstMatrixRef& output, MatrixRef d) {
+    d = d_output.middleRows(first, output.rows());
+    return 0.0;
+  };
+  auto step = [&] {
+    std::fill(grads.begin(), grads.end(), 0.0f);
+    if (chunked) {
+      backend->forward_backward(params, model.normalizers(), graph, grads.data(), loss);
+    } else {
+      network.forward(params, model.normalizers(), graph, workspace, true);
+      network.backward(params, grads.data(), graph, d_output, workspace);
+    }
+    benchmark::DoNotOptimize(grads.data());
+  };
+  step();  // buffers grow once
+  const auto start = std::chrono::steady_clock::now();
+  for (auto _ : state) step();
+  const double seconds = seconds_since(start);
+  state.counters["mesh_nodes"] = graph.num_mesh_nodes();
+  state.counters["samples_per_second"] = kScenes * state.iterations() / seconds;
+  // The products' engine of this run for the references: Eigen for the path before.
+  const double achieved = 3.0 * network.forward_flops(graph) * state.iterations() / seconds / 1e9;
+  add_references(state, achieved, graph.mesh_edges.size() / kScenes, model.config().latent_size,
+                 threads);
+  Eigen::setNbThreads(0);
+  set_gemm_engine(engine);
 }
 
 BENCHMARK_CAPTURE(BM_Inference, paper, "paper")
@@ -121,7 +266,20 @@ BENCHMARK_CAPTURE(BM_TrainingStep, paper, "paper")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_TrainingStep, small, "small")
+    ->Arg(1)
     ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_TrainingBatch, small_whole_eigen, "small", false)
+    ->Arg(1)
+    ->Arg(2)
+    ->MinTime(3.0)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_TrainingBatch, small_chunked, "small", true)
+    ->Arg(1)
+    ->Arg(2)
+    ->MinTime(3.0)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

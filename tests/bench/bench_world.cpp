@@ -31,10 +31,13 @@ SceneSpec grid_scene(int count) {
   return spec;
 }
 
+// The network alone (no free flight, sleep or guard): every body goes through the predictor at
+// every frame, so these measure what the network and the world's own work cost per body.
 WorldFactory fignet_world(std::shared_ptr<const Model> model) {
   return [model](btDispatcher* d, btBroadphaseInterface* b, btConstraintSolver* s,
                  btCollisionConfiguration* c) {
-    return std::make_unique<FIGNetDynamicsWorld>(d, b, s, c, model);
+    return std::make_unique<FIGNetDynamicsWorld>(d, b, s, c, model,
+                                                 FIGNetWorldOptions::network_alone());
   };
 }
 
@@ -43,7 +46,7 @@ WorldFactory gravity_world() {
             btCollisionConfiguration* c) {
     return std::make_unique<FIGNetDynamicsWorld>(
         d, b, s, c, std::make_unique<GravityPredictor>(Vec3(0, 0, -10), 1.0 / 48.0), GraphConfig{},
-        1.0 / 48.0, Vec3(0, 0, -10));
+        1.0 / 48.0, Vec3(0, 0, -10), FIGNetWorldOptions::network_alone());
   };
 }
 

@@ -127,6 +127,28 @@ TEST(CpuBackend, ResultsDoNotDependOnTheThreadCount) {
   EXPECT_EQ(one.split_grads, one.grads);
 }
 
+// One graph run whole (a single scene, a small batch) threads its products instead: the same
+// bits for any thread count too.
+TEST(CpuBackend, WholeGraphResultsDoNotDependOnTheThreadCount) {
+  const Batch batch;
+  auto run = [&](int threads) {
+    return with_threads(threads, [&] {
+      NetworkWorkspace workspace;
+      RowMatrixXf output = batch.network.forward(batch.params.data(), batch.normalizers,
+                                                 batch.graph, workspace, true);
+      std::vector<float> grads(batch.params.size(), 0.0f);
+      batch.network.backward(batch.params.data(), grads.data(), batch.graph, batch.weights,
+                             workspace);
+      return std::pair(output, grads);
+    });
+  };
+  const auto one = run(1), two = run(2), four = run(4);
+  EXPECT_EQ(two.first, one.first);
+  EXPECT_EQ(four.first, one.first);
+  EXPECT_EQ(two.second, one.second);
+  EXPECT_EQ(four.second, one.second);
+}
+
 // The network's products through Eigen and through oneDNN agree to float tolerance.
 TEST(CpuBackend, ProductEnginesAgree) {
   if (!gemm_engine_available(GemmEngine::kOneDnn)) GTEST_SKIP() << "this build has no oneDNN";

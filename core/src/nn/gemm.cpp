@@ -57,7 +57,11 @@ void onednn_gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& 
   const Eigen::Index m = c.rows(), n = c.cols();
   const Eigen::Index k = op_a == Transpose::kNo ? a.cols() : a.rows();
   // oneDNN's OpenMP runtime takes omp_get_max_threads(); follow Eigen's setting, as Eigen would.
-  const int threads = Eigen::nbThreads(), before = omp_get_max_threads();
+  // Except for aᵀ·b (weight gradients: sums over the rows of a batch), which oneDNN may split
+  // along that sum between threads: one thread keeps the sum's order, and the gradients, the same
+  // for any thread count.
+  const int threads = op_a == Transpose::kYes ? 1 : Eigen::nbThreads();
+  const int before = omp_get_max_threads();
   if (threads != before) omp_set_num_threads(threads);
   // Row-major throughout: oneDNN's sgemm takes row-major operands and leading dimensions.
   const dnnl_status_t status =

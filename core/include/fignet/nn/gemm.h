@@ -6,8 +6,9 @@
 //   - Eigen: compiled for the build's target (x86-64-v3, or baseline x86-64 in the portable
 //     preset); the fallback of a build without oneDNN.
 // Both use the threads Eigen::nbThreads() gives (Eigen::setNbThreads, OpenMP's default otherwise)
-// and run single-threaded inside an OpenMP parallel region. Results of one engine are
-// deterministic for a given shape, thread count and processor.
+// and run single-threaded inside an OpenMP parallel region. Results of one engine depend on the
+// shape and the processor, not on the thread count (oneDNN runs op_a = kYes products, the
+// sums over a batch's rows, on one thread for that).
 #pragma once
 
 #include <string>
