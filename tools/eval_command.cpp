@@ -103,7 +103,7 @@ Row evaluate(const std::string& name, const std::string& kind, AccelerationPredi
   const EvaluationTotals mine = evaluate_rollout_totals(predictor, test, options);
   if (group.is_root()) progress.finish(static_cast<long long>(test.size()));
   const std::vector<double> gathered = group.collective->gather(mine.serialize());
-  if (!group.is_root()) return Row{name, kind, summarize(mine, options)};  // not printed
+  if (!group.is_root()) return Row{name, kind, summarize(mine, options), {}};  // not printed
   std::vector<EvaluationTotals> parts;
   for (size_t at = 0; at < gathered.size();) {
     size_t used = 0;
@@ -121,7 +121,7 @@ Row evaluate(const std::string& name, const std::string& kind, AccelerationPredi
     }
   }
   all.per_trajectory = std::move(in_file_order);
-  return Row{name, kind, summarize(all, options)};
+  return Row{name, kind, summarize(all, options), {}};
 }
 
 void print_regimes(const std::vector<Row>& rows) {
