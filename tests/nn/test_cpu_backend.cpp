@@ -43,6 +43,15 @@ struct Batch {
     for (Eigen::Index i = 0; i < weights.size(); ++i) weights.data()[i] = n(rng);
   }
 
+  // Network::forward and backward over the whole graph in one piece: output and gradients.
+  std::pair<RowMatrixXf, std::vector<float>> run_whole() const {
+    NetworkWorkspace workspace;
+    RowMatrixXf output = network.forward(params.data(), normalizers, graph, workspace, true);
+    std::vector<float> grads(params.size(), 0.0f);
+    network.backward(params.data(), grads.data(), graph, weights, workspace);
+    return {output, grads};
+  }
+
   LossGradient loss() const {
     return [this](int first, const ConstMatrixRef& output, MatrixRef d_output) {
       d_output = weights.middleRows(first, output.rows());
@@ -76,13 +85,7 @@ double max_difference(const std::vector<float>& a, const std::vector<float>& b) 
 TEST(CpuBackend, ChunkedOutputsAndGradientsEqualTheWholeGraphs) {
   const Batch batch;
   ASSERT_GT(batch.graph.num_mesh_nodes(), 2500);
-  // The whole graph in one piece.
-  NetworkWorkspace workspace;
-  const RowMatrixXf whole_output =
-      batch.network.forward(batch.params.data(), batch.normalizers, batch.graph, workspace, true);
-  std::vector<float> whole_grads(batch.params.size(), 0.0f);
-  batch.network.backward(batch.params.data(), whole_grads.data(), batch.graph, batch.weights,
-                         workspace);
+  const auto [whole_output, whole_grads] = batch.run_whole();
   // The backend, in chunks.
   auto backend = make_cpu_backend(batch.network);
   const RowMatrixXf output =
@@ -131,17 +134,7 @@ TEST(CpuBackend, ResultsDoNotDependOnTheThreadCount) {
 // bits for any thread count too.
 TEST(CpuBackend, WholeGraphResultsDoNotDependOnTheThreadCount) {
   const Batch batch;
-  auto run = [&](int threads) {
-    return with_threads(threads, [&] {
-      NetworkWorkspace workspace;
-      RowMatrixXf output = batch.network.forward(batch.params.data(), batch.normalizers,
-                                                 batch.graph, workspace, true);
-      std::vector<float> grads(batch.params.size(), 0.0f);
-      batch.network.backward(batch.params.data(), grads.data(), batch.graph, batch.weights,
-                             workspace);
-      return std::pair(output, grads);
-    });
-  };
+  auto run = [&](int threads) { return with_threads(threads, [&] { return batch.run_whole(); }); };
   const auto one = run(1), two = run(2), four = run(4);
   EXPECT_EQ(two.first, one.first);
   EXPECT_EQ(four.first, one.first);
@@ -156,13 +149,7 @@ TEST(CpuBackend, ProductEnginesAgree) {
   const GemmEngine previous = gemm_engine();
   auto run = [&](GemmEngine engine) {
     set_gemm_engine(engine);
-    NetworkWorkspace workspace;
-    RowMatrixXf output =
-        batch.network.forward(batch.params.data(), batch.normalizers, batch.graph, workspace, true);
-    std::vector<float> grads(batch.params.size(), 0.0f);
-    batch.network.backward(batch.params.data(), grads.data(), batch.graph, batch.weights,
-                           workspace);
-    return std::pair(output, grads);
+    return batch.run_whole();
   };
   const auto eigen = run(GemmEngine::kEigen), onednn = run(GemmEngine::kOneDnn);
   set_gemm_engine(previous);

@@ -11,18 +11,23 @@ namespace fignet {
 
 namespace {
 
+// to += rows [begin, end) of from (of as many columns).
+void append_row_range(const FeatureMatrix& from, int begin, int end, FeatureMatrix& to) {
+  if (end <= begin) return;
+  std::memcpy(to.append_rows(end - begin), from.row(begin),
+              sizeof(float) * static_cast<size_t>(end - begin) * from.cols());
+}
+
 void append_rows(const FeatureMatrix& part, FeatureMatrix& whole, const char* what) {
   if (part.cols() != whole.cols()) {
     throw ConfigError(fmt::format("append_graph: {} have {} columns in the part, {} in the whole",
                                   what, part.cols(), whole.cols()));
   }
-  if (part.rows() == 0) return;
-  float* to = whole.append_rows(part.rows());
-  std::memcpy(to, part.row(0), sizeof(float) * part.rows() * part.cols());
+  append_row_range(part, 0, part.rows(), whole);
 }
 
 // whole += part[skip..] + offset.
-void append_offset(const std::vector<std::int32_t>& part, std::int32_t offset,
+void append_offset(std::span<const std::int32_t> part, std::int32_t offset,
                    std::vector<std::int32_t>& whole, size_t skip = 0) {
   if (part.size() <= skip) return;
   const size_t start = whole.size();
@@ -41,17 +46,14 @@ void append_edges(const EdgeSet& part, std::int32_t sender_offset, std::int32_t 
 // part = rows [begin, end) of whole.
 void copy_rows(const FeatureMatrix& whole, int begin, int end, FeatureMatrix& part) {
   part.reset(whole.cols());
-  if (end <= begin) return;
-  std::memcpy(part.append_rows(end - begin), whole.row(begin),
-              sizeof(float) * static_cast<size_t>(end - begin) * whole.cols());
+  append_row_range(whole, begin, end, part);
 }
 
 // part = whole[begin..end) - offset.
 void copy_offset(const std::vector<std::int32_t>& whole, size_t begin, size_t end,
                  std::int32_t offset, std::vector<std::int32_t>& part) {
-  part.resize(end - begin);
-  std::transform(whole.begin() + begin, whole.begin() + end, part.begin(),
-                 [offset](std::int32_t i) { return i - offset; });
+  part.clear();
+  append_offset(std::span(whole).subspan(begin, end - begin), -offset, part);
 }
 
 // Where each part's nodes (or objects) start: starts[i] for part i, then the total.
@@ -82,8 +84,7 @@ void split_edges(const Edges& whole, int arity, const PartStarts& senders,
       to.senders.push_back(s - senders.starts[p]);
       to.receivers.push_back(r - receivers.starts[p]);
     }
-    std::memcpy(to.features.append_rows(1), whole.features.row(static_cast<int>(e)),
-                sizeof(float) * whole.features.cols());
+    append_row_range(whole.features, static_cast<int>(e), static_cast<int>(e) + 1, to.features);
   }
 }
 
