@@ -82,6 +82,30 @@ void adopt_physics(const std::vector<Trajectory>& data, ModelConfig& model) {
   }
 }
 
+// --set on a resumed run: the trainer's fields (loss, optimizer, sampling) may change, which
+// makes the continuation a new run from the checkpoint's weights and optimizer state; the model's
+// fields may not, since the parameters and normalisers were made for them.
+void apply_resume_settings(const std::vector<std::string>& settings, TrainingConfig& config,
+                           bool root) {
+  if (settings.empty()) return;
+  TrainingConfig changed = config;
+  for (const std::string& setting : settings) changed.apply_setting(setting);
+  for (const std::string& name : config.differing_fields(changed)) {
+    if (TrainingConfig::is_model_field(name)) {
+      throw ConfigError(fmt::format(
+          "--set {}: a resumed run keeps its model's fields (the checkpoint has {} = {}); only "
+          "the trainer's fields (batch_size and after in --help's list) may change",
+          name, name, config.field_text(name)));
+    }
+    if (name == "steps") continue;  // --steps has the last word on the run's length
+    if (root) {
+      fmt::print("changed on resume: {} {} -> {}\n", name, config.field_text(name),
+                 changed.field_text(name));
+    }
+  }
+  config.trainer = changed.trainer;
+}
+
 void run_train(const TrainArgs& args) {
   if (args.threads > 0) omp_set_num_threads(args.threads);
   const fs::path checkpoint_path =
@@ -123,6 +147,7 @@ void run_train(const TrainArgs& args) {
     initial = checkpoint.model;
     state = std::move(checkpoint.state);
     if (root) fmt::print("resuming {} at step {}\n", checkpoint_path.string(), state.step);
+    apply_resume_settings(args.settings, config, root);
   } else {
     adopt_physics(data, config.model);
   }
@@ -278,13 +303,13 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "Model file written at every checkpoint and at the end")
       ->required();
   cmd->add_option("--checkpoint", args->checkpoint, "Checkpoint file (default: OUT.ckpt.h5)");
-  // A resumed run keeps its checkpoint's config (anything else would not be the same run).
+  // A resumed run keeps its checkpoint's config unless --set changes a trainer field.
   cmd->add_flag("--resume", args->resume,
                 "Continue the run in the checkpoint file exactly where it stopped, with its "
-                "config (only --steps may change)")
+                "config; --steps and --set of the trainer's fields (batch_size onwards) may "
+                "change it")
       ->excludes(preset)
-      ->excludes(config)
-      ->excludes(settings);
+      ->excludes(config);
   cmd->add_option("--checkpoint-minutes", args->checkpoint_minutes, "Minutes between checkpoints")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();

@@ -42,6 +42,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   trainer_config.batch_size = 2;
   trainer_config.seed = 7;
   trainer_config.adam.decay_steps = 20;
+  trainer_config.rest_loss_weight = 30.0f;
   Trainer uninterrupted(tiny_model(), trainer_config, data);
   uninterrupted.run(10, nullptr);
 
@@ -53,6 +54,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   EXPECT_EQ(checkpoint.planned_steps, 10);
   EXPECT_EQ(checkpoint.trainer_config.batch_size, 2);
   EXPECT_EQ(checkpoint.trainer_config.adam.decay_steps, 20);
+  EXPECT_EQ(checkpoint.trainer_config.rest_loss_weight, 30.0f);
   Trainer resumed(checkpoint.model->config(), checkpoint.trainer_config, data,
                   checkpoint.model.get());
   resumed.restore(checkpoint.state);

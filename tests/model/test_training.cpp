@@ -77,15 +77,21 @@ TEST(Trainer, BatchesDoNotDependOnTheThreadCount) {
   EXPECT_EQ(one.second, four.second);
 }
 
+// The loss over every sample of an untrained model under `trainer_config`, after one batch of
+// statistics (the parameters untouched).
+double untrained_loss(const TrainerConfig& trainer_config, const std::vector<Trajectory>& data) {
+  Trainer trainer(small_model(), trainer_config, data);
+  trainer.warm_up_statistics(1);
+  return trainer.evaluate_loss(trainer.samples());
+}
+
 // Huber's loss equals the squared error within delta and grows only linearly beyond it.
 TEST(Trainer, HuberLossIsQuadraticWithinDeltaAndLinearBeyond) {
   const auto data = spinning_cubes(10);
   auto loss_with = [&](float delta) {
     TrainerConfig trainer_config;
     trainer_config.huber_delta = delta;
-    Trainer trainer(small_model(), trainer_config, data);
-    trainer.warm_up_statistics(1);  // statistics, the parameters untouched
-    return trainer.evaluate_loss(trainer.samples());
+    return untrained_loss(trainer_config, data);
   };
   const double squared = loss_with(0.0f);
   ASSERT_GT(squared, 0.0);
@@ -93,6 +99,42 @@ TEST(Trainer, HuberLossIsQuadraticWithinDeltaAndLinearBeyond) {
   const double huber = loss_with(0.05f);
   EXPECT_LT(huber, squared);
   EXPECT_GT(huber, 0.0);
+}
+
+// A cube flying and a cube lying still: only the second is at rest in the truth.
+std::vector<Trajectory> flying_and_resting_cubes(int frames) {
+  auto data = spinning_cubes(frames);
+  data[0].objects[1] =
+      testing::ballistic_object(testing::small_cube(0.3), Vec3(0, 3, 0.3), Vec3::Zero(),
+                                Vec3::Zero(), frames, 1.0 / 48.0, Vec3::Zero());
+  return data;
+}
+
+TEST(TrainingBatch, FlagsBodiesThatStayStillAroundTheFrame) {
+  auto data = flying_and_resting_cubes(6);
+  const double still = kRestSpeed * data[0].time_step;
+  EXPECT_EQ(resting_objects(data[0], 3, still), (std::vector<std::uint8_t>{0, 1}));
+  // A body that moves in the next step alone is not at rest; kinematic bodies never are.
+  data[0].objects[1].poses[4].position.x() += 2 * still;
+  EXPECT_EQ(resting_objects(data[0], 3, still), (std::vector<std::uint8_t>{0, 0}));
+  EXPECT_EQ(resting_objects(data[0], 2, still), (std::vector<std::uint8_t>{0, 1}));
+  data[0].objects[1].kinematic = true;
+  EXPECT_EQ(resting_objects(data[0], 2, still), (std::vector<std::uint8_t>{0, 0}));
+}
+
+// The rest weight multiplies the resting cube's share of the loss and nothing else: the loss is
+// affine in the weight, and weight 0 leaves the flying cube's share alone.
+TEST(Trainer, RestLossWeightScalesOnlyTheRestingBodiesShare) {
+  const auto data = flying_and_resting_cubes(10);
+  auto loss_with = [&](float weight) {
+    TrainerConfig trainer_config;
+    trainer_config.rest_loss_weight = weight;
+    return untrained_loss(trainer_config, data);
+  };
+  const double flying = loss_with(0.0f), both = loss_with(1.0f), weighted = loss_with(5.0f);
+  ASSERT_GT(flying, 0.0);
+  ASSERT_GT(both, flying);  // the untrained network does not hold the cube still
+  EXPECT_NEAR(weighted - both, 4.0 * (both - flying), 1e-6 * weighted);
 }
 
 TEST(Trainer, IsDeterministicForASeed) {

@@ -22,6 +22,7 @@ void write_training(H5::Group group, const TrainerConfig& config, const TrainerS
   write_attribute(group, "gradient_clip", double{config.gradient_clip});
   write_attribute(group, "huber_delta", double{config.huber_delta});
   write_attribute(group, "statistics_warmup", static_cast<long long>(config.statistics_warmup));
+  write_attribute(group, "rest_loss_weight", double{config.rest_loss_weight});
   write_attribute(group, "step", static_cast<long long>(state.step));
   write_attribute(group, "rng", state.rng);
   const hsize_t n = state.first_moment.size();
@@ -44,6 +45,8 @@ void read_training(const H5::Group& group, size_t parameters, const std::string&
     config.huber_delta = static_cast<float>(read_double(group, "huber_delta"));
   if (group.attrExists("statistics_warmup"))
     config.statistics_warmup = static_cast<int>(read_integer(group, "statistics_warmup"));
+  if (group.attrExists("rest_loss_weight"))
+    config.rest_loss_weight = static_cast<float>(read_double(group, "rest_loss_weight"));
   state.step = read_integer(group, "step");
   state.rng = read_string(group, "rng");
   for (auto [name, out] : {std::pair("adam_first_moment", &state.first_moment),

@@ -94,6 +94,9 @@ void Trainer::prepare_batch(const std::vector<SampleRef>& batch, std::mt19937_64
   }
   build_batch_graph(batch, noise);
   gather_targets(graph_, scene_targets_, targets_, in_loss_);
+  if (weighs_rest()) {
+    gather_loss_weights(graph_, scene_resting_, trainer_config_.rest_loss_weight, loss_weights_);
+  }
   times_.build += seconds_since(start);
   if (accumulate) {
     const auto statistics_start = std::chrono::steady_clock::now();
@@ -107,6 +110,7 @@ void Trainer::build_batch_graph(const std::vector<SampleRef>& batch, std::mt1993
   const int scenes = static_cast<int>(batch.size());
   scenes_.resize(scenes);
   scene_targets_.resize(scenes);
+  if (weighs_rest()) scene_resting_.resize(scenes);
   // One noise seed per scene, drawn in scene order: the noise does not depend on the threads.
   scene_seeds_.resize(scenes);
   for (std::uint64_t& seed : scene_seeds_) seed = noise();
@@ -115,6 +119,11 @@ void Trainer::build_batch_graph(const std::vector<SampleRef>& batch, std::mt1993
       std::mt19937_64 rng(scene_seeds_[b]);
       make_noisy_sample(data_[batch[b].trajectory], batch[b].frame, h, config_.noise_std,
                         config_.noise, rng, scenes_[b], scene_targets_[b]);
+      if (weighs_rest()) {
+        const Trajectory& trajectory = data_[batch[b].trajectory];
+        scene_resting_[b] =
+            resting_objects(trajectory, batch[b].frame, kRestSpeed * trajectory.time_step);
+      }
     }
   };
   // Contiguous runs of scenes per thread; small batches stay on the calling thread.
@@ -220,16 +229,18 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
   };
   const float scale = 2.0f / static_cast<float>(3 * count);
   // The loss of the output rows of nodes [first, first + rows), and its gradient when asked.
+  const bool weighted = weighs_rest();
   auto node_loss = [&](int first, const ConstMatrixRef& output, MatrixRef* d_output) {
     double squares = 0.0;
     if (d_output) d_output->setZero();
     for (Eigen::Index r = 0; r < output.rows(); ++r) {
       const Eigen::Index i = first + r;
       if (!in_loss_[i]) continue;
+      const float weight = weighted ? loss_weights_[i] : 1.0f;
       for (int c = 0; c < 3; ++c) {
         const double error = output(r, c) - normalized_targets_(i, c);
-        squares += loss_of(error);
-        if (d_output) (*d_output)(r, c) = scale * slope_of(error);
+        squares += weight * loss_of(error);
+        if (d_output) (*d_output)(r, c) = scale * weight * slope_of(error);
       }
     }
     return squares;

@@ -1,5 +1,6 @@
 #include "fignet/train/training_batch.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace fignet {
@@ -70,6 +71,23 @@ void make_noisy_sample(const Trajectory& trajectory, int frame, int history, dou
   }
 }
 
+std::vector<std::uint8_t> resting_objects(const Trajectory& trajectory, int frame,
+                                          double max_step) {
+  std::vector<std::uint8_t> resting(trajectory.objects.size(), 0);
+  if (frame < 1 || frame + 1 >= trajectory.num_frames()) return resting;
+  for (size_t o = 0; o < trajectory.objects.size(); ++o) {
+    const TrajectoryObject& object = trajectory.objects[o];
+    if (object.kinematic) continue;
+    const Points before = posed_vertices(*object.mesh, object.poses[frame - 1]);
+    const Points now = posed_vertices(*object.mesh, object.poses[frame]);
+    const Points after = posed_vertices(*object.mesh, object.poses[frame + 1]);
+    const double moved = std::max((now - before).rowwise().norm().maxCoeff(),
+                                  (after - now).rowwise().norm().maxCoeff());
+    resting[o] = moved < max_step ? 1 : 0;
+  }
+  return resting;
+}
+
 void gather_targets(const Graph& graph, const std::vector<Points>& scene_targets,
                     RowMatrixXf& targets, std::vector<std::uint8_t>& in_loss) {
   targets.setZero(graph.num_mesh_nodes(), 3);
@@ -80,6 +98,23 @@ void gather_targets(const Graph& graph, const std::vector<Points>& scene_targets
     targets.middleRows(first_node, t.rows()) = t.cast<float>();
     for (Eigen::Index i = 0; i < t.rows(); ++i) {
       in_loss[first_node + i] = graph.node_kinematic[first_node + i] ? 0 : 1;
+    }
+  }
+}
+
+void gather_loss_weights(const Graph& graph,
+                         const std::vector<std::vector<std::uint8_t>>& scene_resting,
+                         float rest_weight, std::vector<float>& weights) {
+  weights.assign(graph.num_mesh_nodes(), 0.0f);
+  for (int s = 0; s < graph.num_scenes(); ++s) {
+    const int first_object = graph.scene_first_object[s];
+    const std::vector<std::uint8_t>& resting = scene_resting[s];
+    for (size_t o = 0; o < resting.size(); ++o) {
+      const int object = first_object + static_cast<int>(o);
+      const float weight = resting[o] ? rest_weight : 1.0f;
+      for (int i = graph.object_first_node[object]; i < graph.object_first_node[object + 1]; ++i) {
+        weights[i] = graph.node_kinematic[i] ? 0.0f : weight;
+      }
     }
   }
 }

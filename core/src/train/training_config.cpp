@@ -95,6 +95,7 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        })},
       {"model_seed",
        plain<std::uint64_t>([](TrainingConfig & c) -> auto& { return c.model.seed; })},
+      // The trainer's fields from here on (is_model_field).
       {"batch_size", plain<int>([](TrainingConfig & c) -> auto& { return c.trainer.batch_size; })},
       {"learning_rate_start", plain<float>([](TrainingConfig & c) -> auto& {
          return c.trainer.adam.learning_rate_start;
@@ -107,6 +108,8 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.gradient_clip; })},
       {"huber_delta",
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.huber_delta; })},
+      {"rest_loss_weight",
+       plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.rest_loss_weight; })},
       {"statistics_warmup",
        plain<int>([](TrainingConfig & c) -> auto& { return c.trainer.statistics_warmup; })},
       {"data_seed",
@@ -155,6 +158,28 @@ const std::vector<std::string>& TrainingConfig::field_names() {
     return out;
   }();
   return names;
+}
+
+bool TrainingConfig::is_model_field(std::string_view name) {
+  for (const auto& [key, field] : fields()) {
+    if (key == "batch_size") return false;
+    if (key == name) return true;
+  }
+  return false;
+}
+
+std::vector<std::string> TrainingConfig::differing_fields(const TrainingConfig& other) const {
+  std::vector<std::string> names;
+  for (const auto& [key, field] : fields()) {
+    if (field.get(*this) != field.get(other)) names.push_back(key);
+  }
+  return names;
+}
+
+std::string TrainingConfig::field_text(std::string_view name) const {
+  const Field* field = find_field(name);
+  if (!field) throw ConfigError(fmt::format("unknown config field '{}'", name));
+  return field->get(*this).dump();
 }
 
 std::string TrainingConfig::to_json() const {
@@ -226,6 +251,11 @@ void TrainingConfig::validate() const {
     if (!(value >= 0.0f) || !std::isfinite(value)) {
       throw ConfigError(fmt::format("{} = {} (must be >= 0; 0 turns it off)", name, value));
     }
+  }
+  if (!(trainer.rest_loss_weight >= 0.0f) || !std::isfinite(trainer.rest_loss_weight)) {
+    throw ConfigError(
+        fmt::format("rest_loss_weight = {} (must be >= 0; 1: resting bodies count like the others)",
+                    trainer.rest_loss_weight));
   }
   if (trainer.statistics_warmup < 0 || trainer.statistics_warmup > 1'000'000) {
     throw ConfigError(fmt::format("statistics_warmup = {} (must be in 0..1000000 batches)",

@@ -34,7 +34,15 @@ struct TrainerConfig {
   // Batches whose only use is the input and target statistics, before the first update of a new
   // run, so that early updates see settled normalisers.
   int statistics_warmup = 0;
+  // Weight in the loss of the nodes of bodies at rest in the truth (resting_objects with the
+  // still speed below; 1: no different from the others). Their targets are ~1e-3σ, so a bias
+  // that integrates to metres over a long rest costs the unweighted loss almost nothing.
+  float rest_loss_weight = 1.0f;
 };
+
+// A body is at rest in a training sample when none of its vertices moves faster than this over
+// the steps into and out of the sample's frame (fignet eval's rest regime uses the same speed).
+inline constexpr double kRestSpeed = 0.05;  // m/s
 
 // Everything besides the model that makes training continue exactly where it stopped: the
 // optimizer's moments and step count. Sampling needs no state: each step's generator is seeded
@@ -53,7 +61,7 @@ struct TrainerTimes {
 
 struct TrainStep {
   std::int64_t step = 0;  // steps done, this one included
-  double loss = 0.0;      // mean squared normalised error over the batch's dynamic nodes
+  double loss = 0.0;      // mean squared normalised error over the batch's dynamic nodes (weighted)
   float learning_rate = 0.0f;
   double gradient_norm = 0.0;  // global L2 norm of the gradient, before any clipping
 };
@@ -119,6 +127,7 @@ class Trainer {
   // Mean over every process's dynamic nodes; with `reduce`, counts and gradients are summed
   // over processes.
   double loss_and_gradient(bool with_gradient, bool reduce);
+  bool weighs_rest() const { return trainer_config_.rest_loss_weight != 1.0f; }
   // Scales grads_ to trainer_config_.gradient_clip when longer.
   void clip_gradient();
   std::mt19937_64 step_generator(std::int64_t step) const;
@@ -146,6 +155,10 @@ class Trainer {
   std::vector<Points> scene_targets_;
   RowMatrixXf targets_, normalized_targets_;
   std::vector<std::uint8_t> in_loss_;
+  // Per-node loss weights and the per-scene flags they come from, only when
+  // rest_loss_weight != 1.
+  std::vector<std::vector<std::uint8_t>> scene_resting_;
+  std::vector<float> loss_weights_;
   Normalizers batch_statistics_;
   std::vector<double> statistics_buffer_;
   std::vector<std::uint64_t> scene_seeds_;

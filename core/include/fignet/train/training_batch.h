@@ -28,9 +28,21 @@ std::vector<SampleRef> enumerate_samples(const std::vector<Trajectory>& data, in
 void make_noisy_sample(const Trajectory& trajectory, int frame, int history, double noise_std,
                        NoiseKind kind, std::mt19937_64& rng, Scene& scene, Points& targets);
 
+// Per object of the trajectory: 1 where the body is dynamic and at rest in the truth around the
+// sample, that is every vertex moves less than `max_step` metres over frame − 1 → frame and
+// frame → frame + 1 (a body at the top of a free flight still moves g·dt/2 per step).
+std::vector<std::uint8_t> resting_objects(const Trajectory& trajectory, int frame, double max_step);
+
 // Stacks per-scene targets into graph row order (each scene's floor nodes get zero rows) and
 // marks which rows count in the loss (dynamic nodes).
 void gather_targets(const Graph& graph, const std::vector<Points>& scene_targets,
                     RowMatrixXf& targets, std::vector<std::uint8_t>& in_loss);
+
+// Each node's weight in the loss, in graph row order: 0 for kinematic nodes, `rest_weight` for
+// the nodes of objects flagged in `scene_resting` (per scene, per object as resting_objects
+// gives), 1 for the other dynamic nodes.
+void gather_loss_weights(const Graph& graph,
+                         const std::vector<std::vector<std::uint8_t>>& scene_resting,
+                         float rest_weight, std::vector<float>& weights);
 
 }  // namespace fignet

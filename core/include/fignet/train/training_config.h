@@ -32,6 +32,14 @@ struct TrainingConfig {
   void apply_json(std::string_view json, const std::string& where);
   // Sets one field from "key=value" (value in JSON syntax; bare words are strings).
   void apply_setting(std::string_view setting);
+  // Whether the field belongs to the model (its architecture, graph, noise, normalisers), which a
+  // resumed run cannot change; the others are the trainer's (loss, optimizer, sampling) and the
+  // run's length.
+  static bool is_model_field(std::string_view name);
+  // The fields whose values differ from `other`'s, in documentation order.
+  std::vector<std::string> differing_fields(const TrainingConfig& other) const;
+  // One field's value as JSON text ("0.001", "\"face\""); ConfigError for an unknown name.
+  std::string field_text(std::string_view name) const;
   // Throws ConfigError naming the first invalid field.
   void validate() const;
 };
