@@ -35,6 +35,27 @@ if(FIGNET_BUILD_BULLET_PLUGIN)
   find_package(urdfdom REQUIRED)
   find_package(assimp REQUIRED)
 endif()
+# The Python module needs the Bullet adapter (generate, Scene), pybind11 and Python's headers.
+set(FIGNET_PYTHON_ENABLED OFF)
+if(NOT FIGNET_BUILD_PYTHON STREQUAL "OFF" AND FIGNET_BUILD_BULLET_PLUGIN)
+  # Debian's numpy, pytest and matplotlib belong to the system interpreter; one earlier on PATH
+  # (pyenv, conda) may lack them. -DPython3_EXECUTABLE=... picks another.
+  if(NOT DEFINED Python3_EXECUTABLE AND EXISTS /usr/bin/python3)
+    set(Python3_EXECUTABLE /usr/bin/python3)
+  endif()
+  find_package(Python3 COMPONENTS Interpreter Development.Module)
+  if(Python3_FOUND)
+    find_package(pybind11 CONFIG)
+  endif()
+  if(Python3_FOUND AND pybind11_FOUND)
+    set(FIGNET_PYTHON_ENABLED ON)
+    message(STATUS "fignet: Python module for Python ${Python3_VERSION} (pybind11 ${pybind11_VERSION})")
+  endif()
+endif()
+if(FIGNET_BUILD_PYTHON STREQUAL "ON" AND NOT FIGNET_PYTHON_ENABLED)
+  message(FATAL_ERROR "FIGNET_BUILD_PYTHON=ON needs the Bullet adapter, Python 3's headers and "
+                      "pybind11 (apt-get install python3-dev pybind11-dev python3-numpy)")
+endif()
 if(FIGNET_WITH_MPI)
   find_package(MPI REQUIRED COMPONENTS CXX)  # OpenMPI: data-parallel training and evaluation
 endif()

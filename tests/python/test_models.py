@@ -1,0 +1,66 @@
+"""Models from Python: the same rollouts and figures as the command line."""
+
+import json
+import subprocess
+
+import numpy as np
+
+import fignet
+
+
+def test_a_loaded_model_describes_itself(model):
+    assert model.config["preset"] == "small"
+    assert model.history == 2
+    assert model.parameter_count > 100_000
+    assert abs(model.time_step - 1 / 48) < 1e-12
+    np.testing.assert_array_equal(model.gravity, [0, 0, -10])
+    assert "small" in repr(model)
+
+
+def test_evaluation_equals_fignet_eval_on_the_same_file(tmp_path, cli, model, source_dir):
+    data = tmp_path / "scenes.h5"
+    truths = fignet.generate("movi-a", count=2, seed=21, frames=16, path=data)
+    report = tmp_path / "eval.json"
+    subprocess.run(
+        [cli, "eval", "--model", source_dir / "models" / "movi-a-small.h5", "--data", data,
+         "--threads", "1", "--json", report],
+        check=True, capture_output=True,
+    )
+    (run,) = [r for r in json.loads(report.read_text())["runs"] if r["name"] != "ballistic"]
+    ours = fignet.evaluate(model, truths)
+    for key in ("mean_translation_m", "final_translation_m", "mean_rotation_deg"):
+        assert abs(ours[key] - run[key]) <= 1e-9 * max(1.0, abs(run[key])), key
+    np.testing.assert_allclose(ours["translation_per_frame_m"], run["translation_per_frame_m"],
+                               rtol=1e-9, atol=1e-12)
+    # The same through rollout() and rollout_errors(), one trajectory at a time.
+    means = [fignet.rollout_errors(fignet.rollout(model, t), t)["mean_translation"] for t in truths]
+    assert abs(np.mean(means) - run["mean_translation_m"]) <= 1e-9
+
+
+def test_rollouts_keep_the_given_frames_and_match_one_step_predictions(model):
+    (truth,) = fignet.generate("movi-a", count=1, seed=8, frames=12)
+    predicted = fignet.rollout(model, truth, given_frames=5, frames=10)
+    assert predicted.num_frames == 10
+    np.testing.assert_array_equal(predicted.positions[:5], truth.positions[:5])
+    assert not np.array_equal(predicted.positions[5:], truth.positions[5:10])
+    # The first predicted frame is a one-step prediction from the truth.
+    step = model.predict(truth, 4)
+    np.testing.assert_allclose(step["positions"], predicted.positions[5], rtol=0, atol=1e-12)
+    nodes = sum(truth.vertices(o).shape[0] for o in range(truth.num_objects))
+    assert step["accelerations"].shape == (nodes, 3)
+
+
+def test_pose_errors_on_numpy_equal_rollout_errors(model):
+    (truth,) = fignet.generate("movi-a", count=1, seed=6, frames=10)
+    predicted = fignet.rollout(model, truth)
+    a = fignet.rollout_errors(predicted, truth, first_predicted=3)
+    b = fignet.pose_errors(predicted.positions, predicted.quaternions, truth.positions,
+                           truth.quaternions, first_predicted=3, kinematic=list(truth.kinematic))
+    np.testing.assert_array_equal(a["translation"], b["translation"])
+    assert a["mean_rotation"] == b["mean_rotation"]
+    # An error of exactly 1 m on every object from frame 3 on.
+    shifted = truth.positions.copy()
+    shifted[3:, :, 0] += 1.0
+    c = fignet.pose_errors(shifted, truth.quaternions, truth.positions, truth.quaternions)
+    np.testing.assert_allclose(c["translation"][3:], 1.0, rtol=1e-12)
+    assert c["mean_rotation"] < 1e-9
