@@ -44,6 +44,10 @@ Trajectory poses_only(const py::handle& positions, const py::handle& quaternions
         "objects ({}, {})",
         what, p.shape(0), p.shape(1)));
   }
+  if (!kinematic.empty() && static_cast<py::ssize_t>(kinematic.size()) != p.shape(1)) {
+    throw py::value_error(
+        fmt::format("kinematic: {} flags for {} objects", kinematic.size(), p.shape(1)));
+  }
   Trajectory t;
   t.objects.resize(static_cast<size_t>(p.shape(1)));
   const auto pa = p.unchecked<3>();
@@ -89,10 +93,6 @@ angle (degrees); their means over frames first_predicted … end and their last 
         const std::vector<bool> flags = kinematic.value_or(std::vector<bool>{});
         const Trajectory predicted = poses_only(positions, quaternions, flags, "predicted");
         const Trajectory truth = poses_only(true_positions, true_quaternions, flags, "truth");
-        if (!flags.empty() && flags.size() != truth.objects.size()) {
-          throw py::value_error(fmt::format("kinematic: {} flags for {} objects", flags.size(),
-                                            truth.objects.size()));
-        }
         check_matching(predicted, truth);
         return errors_dict(rollout_errors(predicted, truth, first_predicted));
       },

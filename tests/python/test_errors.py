@@ -59,3 +59,10 @@ def test_misuse_of_models_and_scenes_raises(model):
     scene.step()
     with pytest.raises(fignet.ConfigError, match="after the first step"):
         scene.add_body(vertices, faces)
+
+
+def test_pose_errors_check_the_kinematic_flags_against_the_objects():
+    positions = np.zeros((4, 3, 3))
+    quaternions = np.tile([1.0, 0, 0, 0], (4, 3, 1))
+    with pytest.raises(ValueError, match="kinematic: 1 flags for 3 objects"):
+        fignet.pose_errors(positions, quaternions, positions, quaternions, kinematic=[False])
