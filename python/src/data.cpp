@@ -57,8 +57,7 @@ py::array_t<double> positions_of(const Trajectory& t) {
 
 py::array_t<double> quaternions_of(const Trajectory& t) {
   return per_frame(t, 4, [](const TrajectoryObject& o, py::ssize_t f, double* row) {
-    const Eigen::Quaterniond& q = o.poses[f].orientation;
-    row[0] = q.w(), row[1] = q.x(), row[2] = q.y(), row[3] = q.z();
+    write_wxyz(o.poses[f].orientation, row);
   });
 }
 
@@ -83,8 +82,7 @@ py::array_t<T> per_object(const Trajectory& t, Get get) {
 // Poses of one object from (T, 3) positions and (T, 4) quaternions.
 std::vector<Pose> poses_from(const py::handle& positions, const py::handle& quaternions,
                              const char* what) {
-  using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
-  const Array p = Array::ensure(positions), q = Array::ensure(quaternions);
+  const DoubleArray p = double_array(positions), q = double_array(quaternions);
   if (!p || p.ndim() != 2 || p.shape(1) != 3) {
     throw py::value_error(fmt::format("{}: positions must have shape (frames, 3)", what));
   }
@@ -98,7 +96,7 @@ std::vector<Pose> poses_from(const py::handle& positions, const py::handle& quat
     const double* x = p.data() + 3 * f;
     const double* r = q.data() + 4 * f;
     poses[f].position = Vec3(x[0], x[1], x[2]);
-    const Eigen::Quaterniond turn(r[0], r[1], r[2], r[3]);
+    const Eigen::Quaterniond turn = read_wxyz(r);
     if (!std::isfinite(turn.norm()) || !(turn.norm() > 1e-12) || !poses[f].position.allFinite()) {
       throw py::value_error(fmt::format("{}: frame {}: a zero or non-finite pose", what, f));
     }

@@ -32,8 +32,7 @@ py::dict errors_dict(const RolloutErrors& e) {
 // Poses (T, N, 3) and (T, N, 4) as a mesh-less trajectory: all rollout_errors reads.
 Trajectory poses_only(const py::handle& positions, const py::handle& quaternions,
                       const std::vector<bool>& kinematic, const char* what) {
-  using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
-  const Array p = Array::ensure(positions), q = Array::ensure(quaternions);
+  const DoubleArray p = double_array(positions), q = double_array(quaternions);
   if (!p || p.ndim() != 3 || p.shape(2) != 3) {
     throw py::value_error(fmt::format("{}: positions must have shape (frames, objects, 3)", what));
   }
@@ -58,8 +57,7 @@ Trajectory poses_only(const py::handle& positions, const py::handle& quaternions
     object.poses.resize(static_cast<size_t>(p.shape(0)));
     for (py::ssize_t f = 0; f < p.shape(0); ++f) {
       object.poses[f].position = Vec3(pa(f, o, 0), pa(f, o, 1), pa(f, o, 2));
-      object.poses[f].orientation =
-          Eigen::Quaterniond(qa(f, o, 0), qa(f, o, 1), qa(f, o, 2), qa(f, o, 3));
+      object.poses[f].orientation = read_wxyz(qa.data(f, o, 0));
     }
   }
   return t;

@@ -96,19 +96,10 @@ py::dict predict_step(const ModelHandle& model, const Trajectory& truth, int fra
     scene_at_frame(truth, frame, h, scene);
     predict_next_poses(predictor, scene, next, workspace);
   }
-  py::array_t<double> positions({static_cast<py::ssize_t>(next.size()), py::ssize_t{3}});
-  py::array_t<double> quaternions({static_cast<py::ssize_t>(next.size()), py::ssize_t{4}});
-  for (size_t o = 0; o < next.size(); ++o) {
-    const Pose& p = next[o];
-    for (int c = 0; c < 3; ++c) positions.mutable_at(o, c) = p.position[c];
-    const Eigen::Quaterniond& q = p.orientation;
-    quaternions.mutable_at(o, 0) = q.w(), quaternions.mutable_at(o, 1) = q.x();
-    quaternions.mutable_at(o, 2) = q.y(), quaternions.mutable_at(o, 3) = q.z();
-  }
   py::dict out;
   out["accelerations"] = points_array(workspace.accelerations);
-  out["positions"] = positions;
-  out["quaternions"] = quaternions;
+  out["positions"] = positions_array(next);
+  out["quaternions"] = quaternions_array(next);
   return out;
 }
 

@@ -7,11 +7,7 @@
 namespace fignet::python {
 
 Points to_points(const py::handle& array, const char* what) {
-  py::array_t<double, py::array::c_style | py::array::forcecast> values;
-  try {
-    values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(array);
-  } catch (const py::error_already_set&) {
-  }
+  const DoubleArray values = double_array(array);
   if (!values || values.ndim() != 2 || values.shape(1) != 3) {
     throw py::value_error(std::string(what) + ": expected an array of shape (n, 3) of numbers");
   }
@@ -45,11 +41,7 @@ namespace {
 // A flat array of `n` numbers from any sequence, or ValueError.
 std::vector<double> numbers(const py::handle& values, py::ssize_t n, const char* what,
                             const char* shape) {
-  py::array_t<double, py::array::c_style | py::array::forcecast> array;
-  try {
-    array = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
-  } catch (const py::error_already_set&) {
-  }
+  const DoubleArray array = double_array(values);
   if (!array || array.size() != n || array.ndim() != 1) {
     throw py::value_error(std::string(what) + ": expected " + shape + " numbers");
   }
@@ -86,10 +78,27 @@ py::array_t<double> vec3_array(const Vec3& v) {
   return out;
 }
 
-py::array_t<double> quaternion_array(const Eigen::Quaterniond& q) {
-  py::array_t<double> out(4);
-  double* d = out.mutable_data();
-  d[0] = q.w(), d[1] = q.x(), d[2] = q.y(), d[3] = q.z();
+void write_wxyz(const Eigen::Quaterniond& q, double* out) {
+  out[0] = q.w(), out[1] = q.x(), out[2] = q.y(), out[3] = q.z();
+}
+
+Eigen::Quaterniond read_wxyz(const double* in) {
+  return {in[0], in[1], in[2], in[3]};
+}
+
+py::array_t<double> positions_array(std::span<const Pose> poses) {
+  py::array_t<double> out({static_cast<py::ssize_t>(poses.size()), py::ssize_t{3}});
+  for (size_t i = 0; i < poses.size(); ++i) {
+    std::copy_n(poses[i].position.data(), 3, out.mutable_data() + 3 * i);
+  }
+  return out;
+}
+
+py::array_t<double> quaternions_array(std::span<const Pose> poses) {
+  py::array_t<double> out({static_cast<py::ssize_t>(poses.size()), py::ssize_t{4}});
+  for (size_t i = 0; i < poses.size(); ++i) {
+    write_wxyz(poses[i].orientation, out.mutable_data() + 4 * i);
+  }
   return out;
 }
 

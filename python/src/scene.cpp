@@ -85,23 +85,11 @@ class PyScene {
     return out;
   }
 
-  py::array_t<double> positions() const {
-    py::array_t<double> out(std::vector<py::ssize_t>{size(), 3});
-    for (int b = 0; b < size(); ++b) {
-      const Vec3 p = mesh_pose(b).position;
-      for (int c = 0; c < 3; ++c) out.mutable_at(b, c) = p[c];
-    }
-    return out;
-  }
-
-  py::array_t<double> quaternions() const {
-    py::array_t<double> out(std::vector<py::ssize_t>{size(), 4});
-    for (int b = 0; b < size(); ++b) {
-      const Eigen::Quaterniond q = mesh_pose(b).orientation;
-      out.mutable_at(b, 0) = q.w(), out.mutable_at(b, 1) = q.x();
-      out.mutable_at(b, 2) = q.y(), out.mutable_at(b, 3) = q.z();
-    }
-    return out;
+  // Every body's mesh frame, in order.
+  std::vector<Pose> mesh_poses() const {
+    std::vector<Pose> poses(static_cast<size_t>(size()));
+    for (int b = 0; b < size(); ++b) poses[b] = mesh_pose(b);
+    return poses;
   }
 
   py::array_t<double> velocities(bool angular) const {
@@ -259,10 +247,12 @@ Returns the body's index.)")
       .def("step", &PyScene::step, py::arg("frames") = 1,
            "Advances `frames` frames (the GIL is released meanwhile). Bodies cannot be added "
            "after the first step.")
-      .def_property_readonly("positions", &PyScene::positions,
-                             "Where each body's mesh frame is (bodies, 3), metres.")
-      .def_property_readonly("quaternions", &PyScene::quaternions,
-                             "Each body's mesh frame orientation (bodies, 4) as (w, x, y, z).")
+      .def_property_readonly(
+          "positions", [](const PyScene& s) { return positions_array(s.mesh_poses()); },
+          "Where each body's mesh frame is (bodies, 3), metres.")
+      .def_property_readonly(
+          "quaternions", [](const PyScene& s) { return quaternions_array(s.mesh_poses()); },
+          "Each body's mesh frame orientation (bodies, 4) as (w, x, y, z).")
       .def_property_readonly(
           "linear_velocities", [](const PyScene& s) { return s.velocities(false); },
           "Centre-of-mass velocities (bodies, 3), m/s.")
