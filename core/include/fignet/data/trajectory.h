@@ -13,6 +13,10 @@
 
 namespace fignet {
 
+// Below this speed a body counts as at rest: fignet eval's rest regime (centre of mass) and the
+// training loss's rest weight (every vertex) both use it.
+inline constexpr double kRestSpeed = 0.05;  // m/s
+
 struct TrajectoryObject {
   std::shared_ptr<const TriangleMesh> mesh;  // rest mesh in the centre-of-mass frame
   StaticProperties properties;

@@ -24,7 +24,7 @@ std::string_view regime_name(Regime regime);
 
 struct OneStepOptions {
   // Rest: in contact and, in the truth, moving slower than these over the predicted step.
-  double rest_speed = 0.05;          // m/s of the centre of mass
+  double rest_speed = kRestSpeed;    // m/s of the centre of mass
   double rest_angular_speed = 0.25;  // rad/s
   // Impact: the truth's centre-of-mass acceleration differs from gravity by more than this many
   // g (resting contact differs by one g).

@@ -34,15 +34,12 @@ struct TrainerConfig {
   // Batches whose only use is the input and target statistics, before the first update of a new
   // run, so that early updates see settled normalisers.
   int statistics_warmup = 0;
-  // Weight in the loss of the nodes of bodies at rest in the truth (resting_objects with the
-  // still speed below; 1: no different from the others). Their targets are ~1e-3σ, so a bias
-  // that integrates to metres over a long rest costs the unweighted loss almost nothing.
+  // Weight in the loss of the nodes of bodies at rest in the truth (resting_objects: no vertex
+  // faster than kRestSpeed into and out of the sample's frame; 1: no different from the others).
+  // Their targets are ~1e-3σ, so a bias that integrates to metres over a long rest costs the
+  // unweighted loss almost nothing.
   float rest_loss_weight = 1.0f;
 };
-
-// A body is at rest in a training sample when none of its vertices moves faster than this over
-// the steps into and out of the sample's frame (fignet eval's rest regime uses the same speed).
-inline constexpr double kRestSpeed = 0.05;  // m/s
 
 // Everything besides the model that makes training continue exactly where it stopped: the
 // optimizer's moments and step count. Sampling needs no state: each step's generator is seeded
