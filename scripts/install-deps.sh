@@ -8,7 +8,7 @@ packages=(
   libbullet-dev libbullet-extras-dev
   libeigen3-dev libdnnl-dev
   liburdfdom-dev libtinyxml-dev libconsole-bridge-dev
-  libassimp-dev assimp-testmodels
+  libassimp-dev assimp-testmodels libcgal-dev libmeshoptimizer-dev
   libhdf5-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -24,6 +24,8 @@ namespace {
 
 struct GenerateArgs {
   bullet::GenerateOptions options;
+  std::string mesh_inertia = "auto";
+  bool no_repair = false;
   std::string shard = "0/1";
   std::filesystem::path out;
 };
@@ -34,6 +36,8 @@ void run_generate(GenerateArgs args) {
   if (!std::regex_match(args.shard, match, shard_pattern)) {
     throw ConfigError(fmt::format("--shard '{}' must look like i/N (for example 0/4)", args.shard));
   }
+  args.options.scene.mesh_import.inertia = bullet::parse_mesh_inertia(args.mesh_inertia);
+  args.options.scene.mesh_import.repair = !args.no_repair;
   args.options.shard = std::stoi(match[1]);
   args.options.shards = std::stoi(match[2]);
   const auto parent = args.out.parent_path();
@@ -89,7 +93,24 @@ void add_generate_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--assets", args->options.scene.assets,
                   "Folder of mesh files (OBJ, STL, PLY, glTF, OFF): extra objects for movi-b, the "
-                  "only objects of movi-c");
+                  "only objects of movi-c; open and messy meshes are repaired (one warning line "
+                  "each says what was done)");
+  bullet::MeshImportOptions& mesh = args->options.scene.mesh_import;
+  cmd->add_option("--mesh-inertia", args->mesh_inertia,
+                  "Asset mass and inertia: auto (volume if closed, else convex hull), volume, "
+                  "convex or shell (density per m² of surface)")
+      ->check(CLI::IsMember({"auto", "volume", "convex", "shell"}))
+      ->capture_default_str();
+  cmd->add_option("--graph-vertices", mesh.max_graph_vertices,
+                  "Assets with more vertices are simplified for the graph (0: never)")
+      ->check(CLI::Range(0, 100'000'000))
+      ->capture_default_str();
+  cmd->add_option("--simplify-tolerance", mesh.simplify_tolerance,
+                  "Largest deviation of a simplified asset, as a fraction of its largest side")
+      ->check(CLI::Range(1e-6, 1.0))
+      ->capture_default_str();
+  cmd->add_flag("--no-repair", args->no_repair,
+                "Give FIGNet open assets as they are instead of a closed alpha wrap");
   cmd->add_option("--threads", args->options.threads, "Worker threads (0: every core)")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();

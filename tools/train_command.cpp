@@ -67,10 +67,21 @@ TrainingConfig resolve_config(const TrainArgs& args) {
   return config;
 }
 
+// The finest mesh of the data: the resolution the model will know (metadata, no parameter
+// depends on it, so a resumed run may record it too).
+int most_mesh_vertices(const std::vector<Trajectory>& data) {
+  int most = 0;
+  for (const Trajectory& t : data)
+    for (const TrajectoryObject& object : t.objects)
+      most = std::max(most, object.mesh->num_vertices());
+  return most;
+}
+
 // Time step and gravity come from the data, which must agree on them.
 void adopt_physics(const std::vector<Trajectory>& data, ModelConfig& model) {
   model.time_step = data.front().time_step;
   model.gravity = data.front().gravity;
+  model.mesh_vertices = most_mesh_vertices(data);
   for (size_t i = 0; i < data.size(); ++i) {
     if (data[i].time_step != model.time_step || data[i].gravity != model.gravity) {
       throw ConfigError(fmt::format(
@@ -139,6 +150,7 @@ void run_train(const TrainArgs& args) {
     Checkpoint checkpoint = load_checkpoint(checkpoint_path);
     const std::int64_t steps = config.steps;
     config.model = checkpoint.model->config();
+    if (config.model.mesh_vertices == 0) config.model.mesh_vertices = most_mesh_vertices(data);
     config.trainer = checkpoint.trainer_config;
     // The run's own length unless --steps says otherwise.
     config.steps = args.steps >= 0                ? steps
@@ -147,6 +159,10 @@ void run_train(const TrainArgs& args) {
     initial = checkpoint.model;
     state = std::move(checkpoint.state);
     if (root) fmt::print("resuming {} at step {}\n", checkpoint_path.string(), state.step);
+    if (config.steps < state.step) {
+      throw ConfigError(fmt::format("--steps {}: the checkpoint is already at step {}",
+                                    config.steps, state.step));
+    }
     apply_resume_settings(args.settings, config, root);
   } else {
     adopt_physics(data, config.model);

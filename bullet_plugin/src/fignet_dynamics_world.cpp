@@ -57,6 +57,15 @@ std::vector<Pose> seed_history(const Pose& current, const Vec3& linear, const Ve
   return poses;
 }
 
+// The node budget a world of this model uses when the options leave it to the model.
+FIGNetWorldOptions with_model_budget(FIGNetWorldOptions options, const ModelConfig& config) {
+  if (options.max_graph_vertices == FIGNetWorldOptions::kModelResolution &&
+      config.mesh_vertices > 0) {
+    options.max_graph_vertices = config.mesh_vertices;
+  }
+  return options;
+}
+
 }  // namespace
 
 struct FIGNetDynamicsWorld::Impl {
@@ -569,7 +578,7 @@ FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
     : FIGNetDynamicsWorld(dispatcher, broadphase, solver, configuration,
                           std::make_unique<ModelPredictor>(model, options.threads),
                           model->config().graph, model->config().time_step, model->config().gravity,
-                          options) {}
+                          with_model_budget(options, model->config())) {}
 
 FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
                                          btBroadphaseInterface* broadphase,
@@ -599,6 +608,17 @@ FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
         "FIGNetDynamicsWorld: penetration_tolerance is {} m; it must be finite and >= 0",
         options.penetration_tolerance));
   }
+  const int budget = options.max_graph_vertices == FIGNetWorldOptions::kModelResolution
+                         ? FIGNetWorldOptions::kDefaultGraphVertices
+                         : options.max_graph_vertices;
+  if (budget < 0 || (budget > 0 && budget < 4) ||
+      !(options.simplify_tolerance > 0.0 && options.simplify_tolerance <= 1.0)) {
+    throw ConfigError(fmt::format(
+        "FIGNetDynamicsWorld: max_graph_vertices {} (0 for none, or >= 4) and simplify_tolerance "
+        "{} (in (0, 1])",
+        options.max_graph_vertices, options.simplify_tolerance));
+  }
+  if (budget > 0) impl_->shapes = ShapeMeshCache({budget, options.simplify_tolerance});
   setGravity(to_bt(gravity));
 }
 
@@ -745,6 +765,12 @@ void FIGNetDynamicsWorld::internalSingleStepSimulation(btScalar time_step) {
   impl.stats.kinematic_objects = static_cast<int>(impl.scene.objects.size()) - networked;
   impl.stats.candidate_pairs = static_cast<int>(impl.candidates.size());
   impl.stats.face_edges = networked > 0 ? impl.predictor->last_face_edges() : 0;
+  impl.stats.mesh_nodes = 0;
+  if (networked > 0) {
+    for (const SceneObject& object : impl.scene.objects) {
+      impl.stats.mesh_nodes += object.mesh->num_vertices();
+    }
+  }
   if (m_internalTickCallback) (*m_internalTickCallback)(this, time_step);
 }
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <cmath>
 #include <map>
 #include <mutex>
 #include <random>
@@ -31,39 +32,52 @@ struct Source {
 };
 
 // The body of `source` at unit scale and density 1; materials and scales are applied per object.
-BodySpec make_unit_geometry(const Source& source) {
+struct UnitGeometry {
+  BodySpec body;
+  int mass_scale_power = 3;  // shells: mass grows with area, not volume
+};
+
+UnitGeometry make_unit_geometry(const Source& source, const MeshImportOptions& options) {
   if (!source.file) {
-    return make_body(make_movi_shape(source.name), 1.0, 0.0, 0.0, movi_convex_parts(source.name));
+    return {make_body(make_movi_shape(source.name), 1.0, 0.0, 0.0, movi_convex_parts(source.name))};
   }
   const TriangleMesh loaded = load_mesh_file(source.name);
   const Vec3 extent =
       loaded.vertices().colwise().maxCoeff() - loaded.vertices().colwise().minCoeff();
   const double scale = source.largest_side / extent.maxCoeff();
-  return make_body(TriangleMesh(loaded.name(), loaded.vertices() * scale, loaded.faces()),
-                   BodyMaterial{1.0, {}, 0.0, 0.0});
+  const int power = options.inertia == MeshInertia::kShell ? 2 : 3;
+  return {make_body(TriangleMesh(loaded.name(), loaded.vertices() * scale, loaded.faces()),
+                    BodyMaterial{1.0, {}, 0.0, 0.0}, options),
+          power};
 }
 
-// Shared by every scene of the process: a mesh file is loaded and decomposed once.
-const BodySpec& unit_geometry(const Source& source) {
+// Shared by every scene of the process: a mesh file is loaded, repaired and decomposed once (and
+// warned about once).
+const UnitGeometry& unit_geometry(const Source& source, const MeshImportOptions& options) {
   static std::mutex mutex;
-  static std::map<std::pair<std::string, double>, BodySpec> cache;
+  static std::map<std::string, UnitGeometry> cache;
   const std::lock_guard lock(mutex);
-  const auto key = std::pair(source.name, source.largest_side);
+  const std::string key = fmt::format(
+      "{}|{}|{}|{}|{}|{}", source.name, source.largest_side, options.repair,
+      options.max_graph_vertices, options.simplify_tolerance, mesh_inertia_name(options.inertia));
   auto it = cache.find(key);
-  if (it == cache.end()) it = cache.emplace(key, make_unit_geometry(source)).first;
+  if (it == cache.end()) it = cache.emplace(key, make_unit_geometry(source, options)).first;
   return it->second;
 }
 
-// The unit geometry made of `material` and scaled by s: lengths × s, mass × s³, inertia × s⁵.
-BodySpec make_object(const Source& source, const Material& material, double s) {
-  const BodySpec& unit = unit_geometry(source);
-  BodySpec body = unit;
-  body.mesh = std::make_shared<const TriangleMesh>(unit.mesh->name(), unit.mesh->vertices() * s,
-                                                   unit.mesh->faces());
+// The unit geometry made of `material` and scaled by s: lengths × s, mass × s³ and inertia × s⁵
+// (s² and s⁴ for shells).
+BodySpec make_object(const Source& source, const MeshImportOptions& options,
+                     const Material& material, double s) {
+  const UnitGeometry& unit = unit_geometry(source, options);
+  BodySpec body = unit.body;
+  body.mesh = std::make_shared<const TriangleMesh>(
+      unit.body.mesh->name(), unit.body.mesh->vertices() * s, unit.body.mesh->faces());
   for (Points& part : body.convex_parts) part *= s;
-  body.properties = {material.density * unit.properties.mass * s * s * s, material.friction,
+  const double mass_scale = std::pow(s, unit.mass_scale_power);
+  body.properties = {material.density * unit.body.properties.mass * mass_scale, material.friction,
                      material.restitution};
-  body.inertia = material.density * unit.inertia * (s * s * s * s * s);
+  body.inertia = material.density * unit.body.inertia * (mass_scale * s * s);
   return body;
 }
 
@@ -125,7 +139,8 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
     for (const auto& file : asset_files(options.assets))
       sources.push_back({file.string(), true, movi_c ? 1.0 : 2.0});
   }
-  for (const Source& source : sources) unit_geometry(source);  // every asset checked up front
+  for (const Source& source : sources)
+    unit_geometry(source, options.mesh_import);  // checked up front
   SceneSpec spec;
   spec.seed = seed;
   spec.frames = frames_or_default(options, 96);
@@ -144,7 +159,7 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
                          : movi_c ? 0.75 + 2.25 * unit(rng)
                                   : 0.7 + 0.7 * unit(rng);
     const Material& material = movi_c ? kScanned : (unit(rng) < 0.5 ? kMetal : kRubber);
-    BodySpec body = make_object(source, material, scale);
+    BodySpec body = make_object(source, options.mesh_import, material, scale);
     const double radius = body.mesh->vertices().rowwise().norm().maxCoeff();
     bool placed = false;
     for (int attempt = 0; attempt < 100 && !placed; ++attempt) {

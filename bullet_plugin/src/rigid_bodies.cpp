@@ -33,6 +33,7 @@ RigidBodies::~RigidBodies() {
 
 std::unique_ptr<btCollisionShape> RigidBodies::make_shape(const BodySpec& spec, double margin) {
   if (spec.convex_parts.empty()) return make_hull(spec.mesh->vertices(), margin);
+  if (spec.convex_parts.size() == 1) return make_hull(spec.convex_parts.front(), margin);
   auto compound = std::make_unique<btCompoundShape>();
   for (const Points& part : spec.convex_parts) {
     shapes_.push_back(make_hull(part, margin));

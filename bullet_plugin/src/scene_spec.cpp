@@ -33,7 +33,11 @@ BodySpec make_body(const TriangleMesh& mesh, const BodyInertia& inertia, double 
   body.inertia = (axes.transpose() * inertia.inertia * axes).diagonal();
   body.pose.position = com;
   body.pose.orientation = Eigen::Quaterniond(axes);
-  if (convex_parts.size() > 1) {
+  // One part that is the mesh's own points adds nothing to the hull of the mesh.
+  const bool redundant = convex_parts.size() == 1 &&
+                         convex_parts.front().rows() == mesh.vertices().rows() &&
+                         convex_parts.front() == mesh.vertices();
+  if (!convex_parts.empty() && !redundant) {
     for (const Points& part : convex_parts) {
       body.convex_parts.push_back((part.rowwise() - com.transpose()) * axes);
     }
@@ -52,37 +56,35 @@ BodySpec make_body(const TriangleMesh& mesh, double density, double friction, do
 
 namespace fignet::bullet {
 
-BodySpec make_body(const TriangleMesh& mesh, const BodyMaterial& material) {
-  if (!mesh.is_closed()) {
-    throw MeshError(
-        fmt::format("mesh '{}': not closed, so it has no volume and no mass; a "
-                    "dynamic body needs a watertight mesh",
-                    mesh.name()));
-  }
+BodySpec make_body(const TriangleMesh& mesh, const BodyMaterial& material,
+                   const MeshImportOptions& options) {
+  const ImportedMesh imported = import_mesh(mesh, options);
+  const UnitInertia unit = mesh_inertia(imported, options.inertia);
   double density = material.density;
   if (material.mass) {
     if (!(*material.mass > 0.0)) {
       throw ConfigError(
           fmt::format("mesh '{}': mass {} (must be > 0)", mesh.name(), *material.mass));
     }
-    density = *material.mass / compute_mass_properties(mesh).volume;
+    density = *material.mass / unit.mass;
   }
   if (!(density > 0.0)) {
     throw ConfigError(fmt::format("mesh '{}': density {} (must be > 0)", mesh.name(), density));
   }
-  return make_body(mesh, density, material.friction, material.restitution,
-                   decompose_into_convex_parts(mesh));
+  return make_body(imported.surface,
+                   {density * unit.mass, unit.center_of_mass, density * unit.inertia},
+                   material.friction, material.restitution, imported.convex_parts);
 }
 
 BodySpec load_body(const std::filesystem::path& mesh_file, const BodyMaterial& material,
-                   double scale) {
+                   double scale, const MeshImportOptions& options) {
   if (!(scale > 0.0) || !std::isfinite(scale)) {
     throw ConfigError(
         fmt::format("mesh file '{}': scale {} (must be > 0)", mesh_file.string(), scale));
   }
   const TriangleMesh loaded = load_mesh_file(mesh_file);
-  return make_body(TriangleMesh(loaded.name(), loaded.vertices() * scale, loaded.faces()),
-                   material);
+  return make_body(TriangleMesh(loaded.name(), loaded.vertices() * scale, loaded.faces()), material,
+                   options);
 }
 
 }  // namespace fignet::bullet

@@ -113,16 +113,30 @@ auto cache_key(const btCollisionShape& shape) {
 
 }  // namespace
 
+std::shared_ptr<const TriangleMesh> ShapeMeshCache::within_budget(
+    std::shared_ptr<const TriangleMesh> mesh) const {
+  if (!budget_ || budget_->max_vertices <= 0 || mesh->num_vertices() <= budget_->max_vertices) {
+    return mesh;
+  }
+  SimplifiedMesh simplified = simplify_mesh(*mesh, *budget_);
+  // A closed mesh stays closed or stays as it is: its faces' normals must keep meaning outward.
+  if (!simplified.changed || (!simplified.closed && mesh->is_closed())) return mesh;
+  return std::make_shared<const TriangleMesh>(std::move(simplified.mesh));
+}
+
 void ShapeMeshCache::set_mesh(const btCollisionShape& shape,
                               std::shared_ptr<const TriangleMesh> mesh) {
-  meshes_[cache_key(shape)] = std::move(mesh);
+  meshes_[cache_key(shape)] = within_budget(std::move(mesh));
 }
 
 std::shared_ptr<const TriangleMesh> ShapeMeshCache::mesh_of(const btCollisionShape& shape) {
   const auto key = cache_key(shape);
   auto it = meshes_.find(key);
   if (it == meshes_.end()) {
-    it = meshes_.emplace(key, std::make_shared<const TriangleMesh>(shape_to_mesh(shape))).first;
+    it =
+        meshes_
+            .emplace(key, within_budget(std::make_shared<const TriangleMesh>(shape_to_mesh(shape))))
+            .first;
   }
   return it->second;
 }

@@ -204,10 +204,13 @@ class UrdfReader {
       for (const auto& collision : placed.link->collision_array) {
         if (!collision || !collision->geometry) continue;
         const std::string link_where = fmt::format("{}, link '{}'", where_, placed.link->name);
-        const TriangleMesh piece = geometry_mesh(*collision->geometry, link_where);
+        std::vector<Points> piece_parts;
+        bool imported = false;
+        const TriangleMesh piece =
+            geometry_mesh(*collision->geometry, link_where, piece_parts, imported);
         const Transform in_group = placed.in_group * to_transform(collision->origin);
         assembler.append(piece, in_group);
-        std::vector<Points> piece_parts = decompose_into_convex_parts(piece);
+        if (!imported) piece_parts = decompose_into_convex_parts(piece);
         if (piece_parts.empty()) piece_parts.push_back(piece.vertices());
         for (const Points& part : piece_parts) parts.push_back(transformed(part, in_group));
       }
@@ -282,7 +285,10 @@ class UrdfReader {
     return total;
   }
 
-  TriangleMesh geometry_mesh(const urdf::Geometry& geometry, const std::string& where) const {
+  // The mesh of a collision element; a <mesh> file is imported (cleaned, repaired, simplified) and
+  // its convex parts for Bullet come back in `parts` (`imported` set; empty parts: its hull).
+  TriangleMesh geometry_mesh(const urdf::Geometry& geometry, const std::string& where,
+                             std::vector<Points>& parts, bool& imported) const {
     const auto positive = [&](double value, const char* what) {
       if (!(value > 0.0) || !std::isfinite(value)) {
         throw ConfigError(fmt::format("{}: {} {} (must be > 0)", where, what, value));
@@ -311,11 +317,16 @@ class UrdfReader {
                          positive(file.scale.y, "mesh scale y"),
                          positive(file.scale.z, "mesh scale z"));
         TriangleMesh loaded = load_mesh_in_context(resolve(file.filename, where), where);
-        if (!loaded.is_closed()) {
-          throw MeshError(fmt::format("{}: mesh '{}' is not closed, so it has no volume", where,
-                                      file.filename));
+        try {
+          ImportedMesh mesh = import_mesh(
+              TriangleMesh(loaded.name(), loaded.vertices() * scale.asDiagonal(), loaded.faces()),
+              options_.mesh);
+          parts = std::move(mesh.convex_parts);
+          imported = true;
+          return mesh.surface;
+        } catch (const MeshError& e) {
+          throw MeshError(fmt::format("{}: {}", where, e.what()));
         }
-        return TriangleMesh(loaded.name(), loaded.vertices() * scale.asDiagonal(), loaded.faces());
       }
     }
     throw ConfigError(fmt::format("{}: unknown collision geometry", where));

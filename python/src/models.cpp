@@ -29,6 +29,7 @@ py::dict config_of(const Model& model) {
   }
   out["time_step"] = model.config().time_step;
   out["gravity"] = vec3_array(model.config().gravity);
+  out["mesh_vertices"] = model.config().mesh_vertices;
   return out;
 }
 

@@ -173,6 +173,18 @@ bullet::BodyMaterial material_of(std::optional<double> mass, double density, dou
   return material;
 }
 
+// How meshes become bodies; what a mesh needed goes to Python's warnings (a UserWarning).
+bullet::MeshImportOptions import_options(const std::string& inertia, int max_graph_vertices) {
+  bullet::MeshImportOptions options;
+  options.inertia = bullet::parse_mesh_inertia(inertia);
+  options.max_graph_vertices = max_graph_vertices;
+  options.warn = [](const std::string& line) {
+    py::module_::import("warnings")
+        .attr("warn")(line, py::module_::import("builtins").attr("UserWarning"), 3);
+  };
+  return options;
+}
+
 // A kinematic body: no mass, moved by its velocities alone.
 BodySpec kinematic_body(const TriangleMesh& mesh, double friction, double restitution) {
   BodySpec body =
@@ -205,23 +217,30 @@ measures it. Without a model, native Bullet steps at 240 Hz, 5 substeps per fram
              std::optional<double> mass, double density, double friction, double restitution,
              const py::handle& position, const py::handle& orientation,
              const py::handle& linear_velocity, const py::handle& angular_velocity, bool kinematic,
-             const std::string& name) {
+             const std::string& name, const std::string& inertia, int max_graph_vertices) {
             const std::string label = name.empty() ? fmt::format("body {}", scene.size()) : name;
             const TriangleMesh mesh(label, to_points(vertices, "vertices"),
                                     to_triangles(faces, "faces"));
             const BodySpec body =
                 kinematic
                     ? kinematic_body(mesh, friction, restitution)
-                    : bullet::make_body(mesh, material_of(mass, density, friction, restitution));
+                    : bullet::make_body(mesh, material_of(mass, density, friction, restitution),
+                                        import_options(inertia, max_graph_vertices));
             return scene.add_body(body, position, orientation, linear_velocity, angular_velocity);
           },
           py::arg("vertices"), py::arg("faces"), py::arg("mass") = py::none(),
           py::arg("density") = 1000.0, py::arg("friction") = 0.5, py::arg("restitution") = 0.0,
           py::arg("position") = zeros, py::arg("orientation") = identity,
           py::arg("linear_velocity") = zeros, py::arg("angular_velocity") = zeros,
-          py::arg("kinematic") = false, py::arg("name") = "",
-          R"(Adds a body from a closed triangle mesh: vertices (n, 3) in metres and faces (m, 3)
-of vertex indices, wound outward. Mass in kg, or from `density` (kg/m³) and the mesh's volume.
+          py::arg("kinematic") = false, py::arg("name") = "", py::arg("inertia") = "auto",
+          py::arg("max_graph_vertices") = 1000,
+          R"(Adds a body from a triangle mesh: vertices (n, 3) in metres and faces (m, 3) of vertex
+indices. Meshes as they come are accepted: coincident vertices are welded, windings made
+consistent and outward, and an open or broken mesh is given to FIGNet as a closed alpha wrap; a
+mesh with more than `max_graph_vertices` (0: no limit) is simplified for the graph. One
+UserWarning says what a mesh needed. Mass in kg, or from `density` and `inertia`: "auto" (the
+enclosed volume when closed, else the convex hull's), "volume", "convex", or "shell" (density in
+kg/m² of surface).
 `position` and `orientation` (w, x, y, z) place the mesh's own frame; velocities are those of the
 centre of mass (m/s, rad/s). Kinematic bodies have no mass and move at their given velocities.
 Returns the body's index.)")
@@ -230,16 +249,19 @@ Returns the body's index.)")
           [](PyScene& scene, const std::filesystem::path& path, double scale,
              std::optional<double> mass, double density, double friction, double restitution,
              const py::handle& position, const py::handle& orientation,
-             const py::handle& linear_velocity, const py::handle& angular_velocity) {
+             const py::handle& linear_velocity, const py::handle& angular_velocity,
+             const std::string& inertia, int max_graph_vertices) {
             const BodySpec body =
-                bullet::load_body(path, material_of(mass, density, friction, restitution), scale);
+                bullet::load_body(path, material_of(mass, density, friction, restitution), scale,
+                                  import_options(inertia, max_graph_vertices));
             return scene.add_body(body, position, orientation, linear_velocity, angular_velocity);
           },
           py::arg("path"), py::arg("scale") = 1.0, py::arg("mass") = py::none(),
           py::arg("density") = 1000.0, py::arg("friction") = 0.5, py::arg("restitution") = 0.0,
           py::arg("position") = zeros, py::arg("orientation") = identity,
           py::arg("linear_velocity") = zeros, py::arg("angular_velocity") = zeros,
-          "Adds a body from a closed mesh file (OBJ, STL, PLY, glTF, OFF), scaled by `scale`; "
+          py::arg("inertia") = "auto", py::arg("max_graph_vertices") = 1000,
+          "Adds a body from a mesh file (OBJ, STL, PLY, glTF, OFF), scaled by `scale`; "
           "otherwise as add_body.")
       .def("add_floor", &PyScene::add_floor, py::arg("height") = 0.0, py::arg("friction") = 0.3,
            py::arg("restitution") = 0.5,

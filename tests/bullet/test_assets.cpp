@@ -58,11 +58,25 @@ TEST_F(Assets, LoadBodyTakesAMassOrADensity) {
               load_body(path, {1.0, -1.0, 0.5, 0.1});
             }).find("mass -1"),
             std::string::npos);
-  // An open mesh (a box without its top) has no volume.
+  // An open mesh (a box with a square hole, two of its 108 triangles missing) has no volume: the
+  // convex hull's, or its surface's with shell inertia, or an error when the volume is asked
+  // for. One warning says so.
   const TriangleMesh box = make_box(Vec3::Ones());
   Triangles open = box.faces().topRows(box.num_faces() - 2);
   const auto open_path = write_obj(TriangleMesh("open", box.vertices(), open), "open.obj");
-  EXPECT_NE(error_of([&] { load_body(open_path, {}); }).find("open.obj': not closed"),
+  std::vector<std::string> warnings;
+  MeshImportOptions options;
+  options.warn = [&](const std::string& line) { warnings.push_back(line); };
+  const BodySpec hull = load_body(open_path, {1.0, {}, 0.5, 0.1}, 1.0, options);
+  EXPECT_NEAR(hull.properties.mass, 8.0, 1e-9);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("open.obj': 4 open edges"), std::string::npos) << warnings[0];
+  EXPECT_TRUE(hull.mesh->is_closed());  // FIGNet sees a closed surface
+  options.inertia = MeshInertia::kShell;
+  EXPECT_NEAR(load_body(open_path, {1.0, {}, 0.5, 0.1}, 1.0, options).properties.mass,
+              24.0 - 4.0 / 9.0, 1e-7);
+  options.inertia = MeshInertia::kVolume;
+  EXPECT_NE(error_of([&] { load_body(open_path, {}, 1.0, options); }).find("open.obj': not closed"),
             std::string::npos);
 }
 

@@ -14,13 +14,12 @@ std::vector<Simulator> shipped_model_world() {
   return stress_simulators({{"movi-a-small", model}});
 }
 
-// Every case, shortened to a few frames; the two that cost seconds per frame are left out.
+// Every case, shortened to a few frames; the 100-object pile, which costs seconds per frame, is
+// left out (the 20,000-vertex sphere is in: the node budget makes it cheap).
 TEST(Stress, EveryCaseStaysFinite) {
   const auto sims = shipped_model_world();
   for (const StressCase& c : stress_cases(0.01)) {
-    if (c.name.find("100-object") != std::string::npos ||
-        c.name.find("20,000") != std::string::npos)
-      continue;
+    if (c.name.find("100-object") != std::string::npos) continue;
     const std::vector<StressRun> runs = run_stress_case(c, sims);
     for (const StressRun& run : runs) {
       EXPECT_TRUE(run.finite) << c.name << " in " << run.simulator;

@@ -585,3 +585,77 @@ TEST(FIGNetWorld, ABodyFarFromTheOriginStillMeetsTheFloor) {
 
 }  // namespace
 }  // namespace fignet::bullet
+
+namespace fignet::bullet {
+namespace {
+
+// A sphere shape standing for a 20,000-vertex mesh, resting on a plane in a world.
+btRigidBody* add_fine_sphere(testing::WorldFixture& fixture) {
+  fixture.add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0, Pose{});
+  btRigidBody* ball = fixture.add(std::make_unique<btSphereShape>(0.5f), 1.0, at(Vec3(0, 0, 0.52)));
+  fixture.world.set_shape_mesh(*ball->getCollisionShape(),
+                               std::make_shared<const TriangleMesh>(make_sphere(0.5, 140, 143)));
+  return ball;
+}
+
+// The node budget: a fine mesh enters the graph simplified, within its tolerance of the shape.
+TEST(FIGNetWorld, AFineMeshEntersTheGraphWithinTheNodeBudget) {
+  for (const int budget : {0, 64}) {
+    FIGNetWorldOptions options;
+    options.max_graph_vertices = budget;
+    options.free_flight = false;
+    auto predictor = recording_predictor();
+    auto* recorder = predictor.get();
+    WorldFixture fixture(std::move(predictor), {}, options);
+    add_fine_sphere(fixture);
+    fixture.step();
+    ASSERT_EQ(recorder->calls, 1);
+    const TriangleMesh& seen = *recorder->last_scene.objects[0].mesh;
+    if (budget == 0) {
+      EXPECT_EQ(seen.num_vertices(), make_sphere(0.5, 140, 143).num_vertices());
+    } else {
+      // 2 % of the 1 m sphere stops the simplifier near 100 vertices, above the budget of 64.
+      EXPECT_LT(seen.num_vertices(), 150);
+      EXPECT_TRUE(seen.is_closed());
+      const Eigen::VectorXd radii = seen.vertices().rowwise().norm();
+      EXPECT_NEAR(radii.maxCoeff(), 0.5, 1e-9);  // its vertices are the mesh's own
+    }
+    EXPECT_GE(fixture.world.last_step_stats().mesh_nodes, seen.num_vertices());
+  }
+}
+
+// A model's own resolution is the default budget; a model file that predates it leaves 1000.
+TEST(FIGNetWorld, TheModelsTrainingResolutionIsTheDefaultBudget) {
+  for (const int resolution : {0, 64}) {
+    ModelConfig config = ModelConfig::preset_named("small");
+    config.latent_size = 8;
+    config.message_passing_steps = 1;
+    config.mesh_vertices = resolution;
+    auto model = std::make_shared<const Model>(config);
+    btDefaultCollisionConfiguration configuration;
+    btCollisionDispatcher dispatcher(&configuration);
+    btDbvtBroadphase broadphase;
+    btSequentialImpulseConstraintSolver solver;
+    FIGNetWorldOptions options;
+    options.free_flight = false;
+    FIGNetDynamicsWorld world(&dispatcher, &broadphase, &solver, &configuration, model, options);
+    btSphereShape shape(0.5f);
+    btDefaultMotionState state(to_bt(at(Vec3(0, 0, 3))));
+    btRigidBody ball(btRigidBody::btRigidBodyConstructionInfo(1.0f, &state, &shape,
+                                                              btVector3(0.1f, 0.1f, 0.1f)));
+    world.addRigidBody(&ball);
+    world.set_shape_mesh(shape, std::make_shared<const TriangleMesh>(make_sphere(0.5, 140, 143)));
+    world.stepSimulation(btScalar(config.time_step), 1, btScalar(config.time_step));
+    const int nodes = world.last_step_stats().mesh_nodes;
+    if (resolution == 0) {
+      EXPECT_GT(nodes, 500);
+      EXPECT_LE(nodes, FIGNetWorldOptions::kDefaultGraphVertices);
+    } else {
+      EXPECT_LT(nodes, 150);
+    }
+    world.removeRigidBody(&ball);
+  }
+}
+
+}  // namespace
+}  // namespace fignet::bullet

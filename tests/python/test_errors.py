@@ -29,7 +29,23 @@ def test_bad_meshes_raise_mesh_errors():
                                        np.tile([1.0, 0, 0, 0], (2, 1)))
     scene = fignet.Scene()
     with pytest.raises(ValueError, match="not closed"):
-        scene.add_body(vertices, faces[:10])
+        scene.add_body(vertices, faces[:10], inertia="volume")
+    with pytest.raises(fignet.ConfigError, match="expected auto, volume, convex or shell"):
+        scene.add_body(vertices, faces, inertia="solid")
+    flat = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    with pytest.raises(fignet.MeshError, match="flat"):
+        scene.add_body(flat, np.array([[0, 1, 2]]))
+
+
+def test_open_meshes_load_with_one_warning():
+    vertices, faces = box()
+    scene = fignet.Scene()
+    with pytest.warns(UserWarning, match="open edges") as warned:
+        scene.add_body(vertices, faces[:10], name="open box")
+    assert len(warned) == 1 and "open box" in str(warned[0].message)
+    scene.add_floor()
+    scene.step(5)
+    assert np.isfinite(scene.positions).all()
 
 
 def test_bad_files_raise_os_errors(tmp_path):

@@ -42,6 +42,7 @@ void write_config(H5::Group group, const ModelConfig& c) {
   for (int i = 0; i < 3; ++i)
     write_attribute(group, fmt::format("gravity_{}", "xyz"[i]), c.gravity[i]);
   write_attribute(group, "seed", static_cast<long long>(c.seed));
+  write_attribute(group, "mesh_vertices", static_cast<long long>(c.mesh_vertices));
   write_attribute(group, "collision_radius", c.graph.collision_radius);
   write_attribute(group, "history", static_cast<long long>(c.graph.history));
   write_attribute(group, "object_nodes", static_cast<long long>(c.graph.object_nodes));
@@ -70,6 +71,9 @@ ModelConfig read_config(const H5::Group& group) {
   for (int i = 0; i < 3; ++i)
     c.gravity[i] = read_double(group, fmt::format("gravity_{}", "xyz"[i]));
   c.seed = static_cast<std::uint64_t>(read_integer(group, "seed"));
+  if (group.attrExists("mesh_vertices")) {
+    c.mesh_vertices = static_cast<int>(read_integer(group, "mesh_vertices"));
+  }
   c.graph.collision_radius = read_double(group, "collision_radius");
   c.graph.history = static_cast<int>(read_integer(group, "history"));
   c.graph.object_nodes = read_integer(group, "object_nodes") != 0;

@@ -41,6 +41,7 @@ void ModelConfig::validate() const {
   if (normalizer_max_accumulations < 1) {
     fail("normalizer_max_accumulations", normalizer_max_accumulations, "must be >= 1");
   }
+  if (mesh_vertices < 0) fail("mesh_vertices", mesh_vertices, "must be >= 0");
   if (!(time_step > 0.0) || !std::isfinite(time_step)) fail("time_step", time_step, "must be > 0");
   if (!gravity.allFinite()) fail("gravity", "non-finite", "must be finite");
 }

@@ -47,6 +47,19 @@ struct FIGNetWorldOptions {
   // does for its own solver. Depths are Bullet's contact distances (collision margins included).
   bool penetration_guard = true;
   double penetration_tolerance = 0.005;  // metres
+  // The node budget: a body's mesh with more vertices than this is simplified (meshoptimizer,
+  // once per shape) within simplify_tolerance of its largest side before it enters the graph, so
+  // a 20,000-vertex mesh costs about what the model's own meshes cost; the tolerance keeps the
+  // shape and may stop above the budget. Bullet's collision shape is untouched.
+  // kModelResolution: the finest mesh the model was trained on (ModelConfig::mesh_vertices; 64 for
+  // MOVi-A), or kDefaultGraphVertices for a model file that predates it or a bare predictor.
+  // 0: every mesh as it is.
+  static constexpr int kModelResolution = -1;
+  static constexpr int kDefaultGraphVertices = 1000;  // MOVi's finest shape has 960
+  int max_graph_vertices = kModelResolution;
+  // 2 % of the largest side: finer than the model's own meshes are faceted (MOVi's 64-vertex
+  // sphere deviates 3.8 % from the sphere); a 20,000-vertex sphere keeps about 100 vertices.
+  double simplify_tolerance = 0.02;
 
   // The network alone on every awake body, as `fignet eval` rolls out and the paper measures: no
   // free flight, no sleeping, no penetration guard (the sweep guard is kept).
@@ -70,6 +83,7 @@ struct FIGNetStepStats {
   int kinematic_objects = 0;      // static and kinematic bodies in contact range, floor excluded
   int candidate_pairs = 0;        // broadphase pairs handed to the face-pair search
   int face_edges = 0;             // face–face edges of the graph
+  int mesh_nodes = 0;             // mesh vertices in the network's graph (after the node budget)
   int guarded_bodies = 0;         // bodies stopped by the tunnelling guard
   int recovered_bodies = 0;       // bodies moved out of static geometry by the penetration guard
   double prepare_seconds = 0;     // broadphase, islands, meshes and histories

@@ -17,6 +17,8 @@ struct MoviOptions {
   int frames = 0;  // 0: the preset's own (movi-a 96, pushing 42)
   // A folder of mesh files: extra objects for movi-b, the only objects of movi-c.
   std::filesystem::path assets;
+  // How asset meshes become bodies: repair, node budget, inertia mode (see mesh_import.h).
+  MeshImportOptions mesh_import;
 };
 
 // The scene of `seed`: 3–10 objects from {cube, cylinder, sphere}, scale 0.7 or 1.4, metal
@@ -28,8 +30,9 @@ struct MoviOptions {
 // MOVi shapes (non-convex ones as compounds of their exact convex parts) with scale uniform in
 // 0.7–1.4, plus the mesh files of options.assets scaled to a 2 m largest side like the KuBasic
 // shapes. "movi-c" draws only from options.assets: largest side 1 m times U(0.75, 3.0) (Kubric's
-// MOVi-C worker), friction 0.5, restitution 0.5, density 1.0 (facts §1). Mesh files must be
-// closed; non-convex ones collide as HACD decompositions. Throws ConfigError for a bad option,
+// MOVi-C worker), friction 0.5, restitution 0.5, density 1.0 (facts §1). Mesh files may be open
+// or messy (options.mesh_import says how they are repaired, simplified and weighed); non-convex
+// ones collide as HACD decompositions. Throws ConfigError for a bad option,
 // FileError or MeshError for a bad asset folder or file.
 SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed);
 

@@ -10,13 +10,15 @@
 #include <optional>
 #include <vector>
 
+#include "fignet/bullet/mesh_import.h"
 #include "fignet/data/trajectory.h"
 
 namespace fignet::bullet {
 
 struct BodySpec {
   std::shared_ptr<const TriangleMesh> mesh;  // principal centre-of-mass frame
-  // Convex pieces whose union is the body (same frame); empty: the mesh is convex.
+  // Bullet's collision shape as convex pieces (same frame); empty: the hull of the mesh. One
+  // piece: the hull of other points than the mesh's (a mesh simplified for the graph).
   std::vector<Points> convex_parts;
   StaticProperties properties;                        // mass = density × volume (0 when kinematic)
   Eigen::Vector3d inertia = Eigen::Vector3d::Ones();  // principal moments, kg·m²
@@ -56,19 +58,21 @@ BodySpec make_body(const TriangleMesh& mesh, double density, double friction, do
                    const std::vector<Points>& convex_parts = {});
 
 struct BodyMaterial {
-  double density = 1000.0;  // kg/m³; ignored when mass is set
+  double density = 1000.0;  // kg/m³ (kg/m² for shell inertia); ignored when mass is set
   std::optional<double> mass;
   double friction = 0.5, restitution = 0.0;
 };
 
-// A body from a closed mesh in any frame: convex, or split into convex parts by HACD; mass from
-// the material. Throws MeshError or ConfigError naming the mesh.
-BodySpec make_body(const TriangleMesh& mesh, const BodyMaterial& material);
+// A body from a mesh in any frame, as it comes: cleaned, repaired and simplified for the graph
+// by `options` (one warning line says what a mesh needed), convex or split into convex parts by
+// HACD for Bullet, mass and inertia from the material and `options.inertia`. Throws MeshError or
+// ConfigError naming the mesh.
+BodySpec make_body(const TriangleMesh& mesh, const BodyMaterial& material,
+                   const MeshImportOptions& options = {});
 
 // One call from a mesh file (OBJ, STL, PLY, glTF, OFF through assimp) to a body: the mesh scaled
-// by `scale`, convex or split into convex parts by HACD, mass from the material. The mesh must be
-// closed. Throws FileError or MeshError naming the file.
+// by `scale`, then as make_body above. Throws FileError or MeshError naming the file.
 BodySpec load_body(const std::filesystem::path& mesh_file, const BodyMaterial& material,
-                   double scale = 1.0);
+                   double scale = 1.0, const MeshImportOptions& options = {});
 
 }  // namespace fignet::bullet

@@ -7,10 +7,11 @@
 #include <array>
 #include <map>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
-#include "fignet/geometry/mesh.h"
+#include "fignet/geometry/mesh_repair.h"
 
 class btCollisionShape;
 class btConcaveShape;
@@ -34,6 +35,10 @@ std::unique_ptr<TriangleMesh> concave_triangles_in_box(const btConcaveShape& sha
 // Converts each convex or compound shape once. Not thread-safe (one per world).
 class ShapeMeshCache {
  public:
+  // Meshes above `budget.max_vertices` are simplified (once) before they are handed out, so a
+  // body's cost in the graph follows the model's resolution, not the mesh's. Default: no budget.
+  ShapeMeshCache() = default;
+  explicit ShapeMeshCache(const SimplifyOptions& budget) : budget_(budget) {}
   std::shared_ptr<const TriangleMesh> mesh_of(const btCollisionShape& shape);
   // Makes `mesh` the shape's mesh at its current local scaling.
   void set_mesh(const btCollisionShape& shape, std::shared_ptr<const TriangleMesh> mesh);
@@ -45,6 +50,9 @@ class ShapeMeshCache {
   std::map<std::pair<const btCollisionShape*, std::array<double, 3>>,
            std::shared_ptr<const TriangleMesh>>
       meshes_;
+  std::optional<SimplifyOptions> budget_;
+
+  std::shared_ptr<const TriangleMesh> within_budget(std::shared_ptr<const TriangleMesh> mesh) const;
 };
 
 }  // namespace fignet::bullet

@@ -21,6 +21,9 @@ struct UrdfOptions {
   // package://NAME/… mesh URIs resolve to packages[NAME]/…; a NAME not listed resolves to the
   // nearest folder called NAME above the URDF file.
   std::map<std::string, std::filesystem::path> packages;
+  // How <mesh> files become collision pieces: repair of open meshes, the graph's node budget
+  // (mass comes from <inertial>, or the repaired surfaces at default_density).
+  MeshImportOptions mesh;
 };
 
 struct UrdfBody {

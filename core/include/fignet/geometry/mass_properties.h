@@ -18,6 +18,16 @@ struct MassProperties {
 // Throws MeshError when the enclosed volume is not positive (open or inward-facing mesh).
 MassProperties compute_mass_properties(const TriangleMesh& mesh);
 
+// Mass spread over the surface instead of the volume (MuJoCo's shell inertia), for open meshes
+// and thin-walled objects: area, centroid of the surface and inertia tensor about it for unit
+// surface density (kg/m²). Any mesh with positive area works, open or closed, any winding.
+struct ShellProperties {
+  double area = 0.0;
+  Vec3 center_of_mass = Vec3::Zero();
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+};
+ShellProperties compute_shell_properties(const TriangleMesh& mesh);
+
 // The same mesh with its vertices expressed in its centre-of-mass frame (rest meshes handed to
 // the graph builder and to Bullet bodies use this frame).
 TriangleMesh centered_on_center_of_mass(const TriangleMesh& mesh);

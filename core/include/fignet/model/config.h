@@ -29,7 +29,11 @@ struct ModelConfig {
   std::int64_t normalizer_max_accumulations = 1'000'000;  // statistics freeze afterwards
   double time_step = 1.0 / 48.0;   // seconds between the frames the model was trained on
   Vec3 gravity = Vec3(0, 0, -10);  // the training data's gravity
-  std::uint64_t seed = 0;          // parameter initialisation
+  // The most vertices of one object's mesh in the training data (0: unknown, a model file from
+  // before it was recorded): the resolution the model knows, and FIGNetDynamicsWorld's default
+  // node budget for finer meshes.
+  int mesh_vertices = 0;
+  std::uint64_t seed = 0;  // parameter initialisation
 
   // "paper": L = 128, M = 10, d_c = 0.1 m (seed C.2). "small": L = 64, M = 5, about 10x fewer
   // FLOPs, for quick training and fast inference. Throws ConfigError for another name.

@@ -1,0 +1,98 @@
+// simplify_mesh(): meshoptimizer's edge-collapse simplifier under a vertex budget.
+#include <meshoptimizer.h>
+
+#include <fmt/format.h>
+
+#include <vector>
+
+#include "fignet/error.h"
+#include "fignet/geometry/mesh_repair.h"
+
+namespace fignet {
+
+namespace {
+
+// The faces `indices` names, with only the vertices they use (numbered in order of first use).
+TriangleMesh compact(const TriangleMesh& mesh, const std::vector<unsigned>& indices) {
+  std::vector<int> renumber(static_cast<size_t>(mesh.num_vertices()), -1);
+  int used = 0;
+  for (unsigned v : indices)
+    if (renumber[v] < 0) renumber[v] = used++;
+  Points vertices(used, 3);
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    if (renumber[v] >= 0) vertices.row(renumber[v]) = mesh.vertices().row(v);
+  Triangles faces(static_cast<Eigen::Index>(indices.size() / 3), 3);
+  for (size_t i = 0; i < indices.size(); ++i)
+    faces(static_cast<Eigen::Index>(i / 3), static_cast<Eigen::Index>(i % 3)) =
+        renumber[indices[i]];
+  MeshOptions options;
+  options.degenerate_faces = DegenerateFaces::kDrop;
+  return TriangleMesh(mesh.name(), std::move(vertices), std::move(faces), options);
+}
+
+}  // namespace
+
+SimplifiedMesh simplify_mesh(const TriangleMesh& mesh, const SimplifyOptions& options) {
+  if (options.max_vertices < 4) {
+    throw ConfigError(
+        fmt::format("mesh '{}': vertex budget {} (needs >= 4)", mesh.name(), options.max_vertices));
+  }
+  if (!(options.tolerance > 0.0 && options.tolerance <= 1.0)) {
+    throw ConfigError(fmt::format("mesh '{}': simplification tolerance {} (must be in (0, 1])",
+                                  mesh.name(), options.tolerance));
+  }
+  SimplifiedMesh result{mesh, 0.0, false, mesh.is_closed()};
+  if (mesh.num_vertices() <= options.max_vertices) return result;
+
+  // meshoptimizer works in float, relative to the mesh's extent; positions are taken about the
+  // box centre so a mesh far from the origin keeps its precision.
+  const Vec3 centre =
+      0.5 * (mesh.vertices().colwise().maxCoeff() + mesh.vertices().colwise().minCoeff());
+  std::vector<float> positions(static_cast<size_t>(3 * mesh.num_vertices()));
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    for (int k = 0; k < 3; ++k)
+      positions[static_cast<size_t>(3 * v + k)] =
+          static_cast<float>(mesh.vertices()(v, k) - centre[k]);
+  std::vector<unsigned> indices(static_cast<size_t>(3 * mesh.num_faces()));
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k)
+      indices[static_cast<size_t>(3 * f + k)] = static_cast<unsigned>(mesh.faces()(f, k));
+  const double scale = meshopt_simplifyScale(positions.data(), mesh.num_vertices(), 12);
+
+  // The budget is in vertices, meshoptimizer's target in indices: start from the faces a closed
+  // mesh of that many vertices has (about twice as many) and tighten until the budget holds or
+  // the tolerance stops it. A closed mesh must stay closed: an attempt that leaves a non-manifold
+  // edge is retried at a slightly different target.
+  const bool closed = mesh.is_closed();
+  double target_faces = 2.0 * options.max_vertices;
+  std::vector<unsigned> simplified(indices.size());
+  size_t previous = 0;
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    float error = 0.0f;
+    const size_t count = meshopt_simplify(
+        simplified.data(), indices.data(), indices.size(), positions.data(),
+        static_cast<size_t>(mesh.num_vertices()), 12, 3 * static_cast<size_t>(target_faces),
+        static_cast<float>(options.tolerance), 0, &error);
+    if (count == 0 || count == indices.size()) break;  // nothing left, or nothing removed
+    TriangleMesh candidate = compact(
+        mesh,
+        std::vector<unsigned>(simplified.begin(), simplified.begin() + static_cast<long>(count)));
+    const int vertices = candidate.num_vertices();
+    const bool usable = !closed || candidate.is_closed();
+    const bool within = vertices <= options.max_vertices;
+    if (usable) {
+      result.mesh = std::move(candidate);
+      result.error = static_cast<double>(error) * scale;
+      result.changed = true;
+      if (within) break;
+    }
+    // The tolerance stopped it: a smaller target gives the same mesh.
+    if (!within && count == previous) break;
+    previous = count;
+    target_faces *= within ? 0.95 : 0.9 * options.max_vertices / vertices;
+  }
+  result.closed = result.mesh.is_closed();
+  return result;
+}
+
+}  // namespace fignet
