@@ -119,6 +119,7 @@ Trajectory BulletSimulation::record() {
     object.mesh = body.mesh;
     object.properties = body.properties;
     object.kinematic = body.kinematic;
+    if (!body.kinematic) object.inertia = body.inertia;
     trajectory.objects.push_back(std::move(object));
   }
   for (int frame = 0; frame < spec.frames; ++frame) {

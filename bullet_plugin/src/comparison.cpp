@@ -24,12 +24,21 @@ SceneSpec scene_from_trajectory(const Trajectory& trajectory) {
   spec.steps_per_frame = std::max(1, static_cast<int>(std::lround(trajectory.time_step * 240.0)));
   spec.physics_step = trajectory.time_step / spec.steps_per_frame;
   for (const TrajectoryObject& object : trajectory.objects) {
-    const double volume = compute_mass_properties(*object.mesh).volume;
-    const double density = object.kinematic ? 1.0 : object.properties.mass / volume;
-    BodySpec body =
-        make_body(*object.mesh, density, object.properties.friction, object.properties.restitution,
-                  decompose_into_convex_parts(*object.mesh));
-    // The rest mesh is already in its principal frame: keep the recorded mesh itself.
+    BodySpec body;
+    if (object.inertia) {
+      // Recorded inertia: the mesh's frame is the body's, whatever the mesh's own volume says.
+      const std::vector<Points> parts = decompose_into_convex_parts(*object.mesh);
+      body.convex_parts = parts.size() > 1 ? parts : std::vector<Points>{};
+      body.inertia = *object.inertia;
+    } else {
+      // Older files: the uniform-density inertia of the mesh, which is already in its principal
+      // frame.
+      const double volume = compute_mass_properties(*object.mesh).volume;
+      const double density = object.kinematic ? 1.0 : object.properties.mass / volume;
+      body = make_body(*object.mesh, density, object.properties.friction,
+                       object.properties.restitution, decompose_into_convex_parts(*object.mesh));
+    }
+    // The rest mesh is already in the body's frame: keep the recorded mesh itself.
     body.mesh = object.mesh;
     body.properties = object.properties;
     body.kinematic = object.kinematic;

@@ -105,8 +105,9 @@ ImportedMesh import_mesh(const TriangleMesh& mesh, const MeshImportOptions& opti
 
   const std::string actions = result.actions();
   if (!result.defects.clean() || !actions.empty()) {
-    const std::string line = fmt::format("mesh '{}': {}{}{}", mesh.name(), result.defects.summary(),
-                                         actions.empty() ? "" : "; ", actions);
+    const std::string line =
+        fmt::format("mesh '{}' ({} vertices): {}{}{}", mesh.name(), mesh.num_vertices(),
+                    result.defects.summary(), actions.empty() ? "" : "; ", actions);
     if (options.warn) {
       options.warn(line);
     } else {

@@ -112,6 +112,7 @@ class PyScene {
     out["free_flight_bodies"] = s.free_flight_bodies;
     out["sleeping_bodies"] = s.sleeping_bodies;
     out["face_edges"] = s.face_edges;
+    out["mesh_nodes"] = s.mesh_nodes;
     out["guarded_bodies"] = s.guarded_bodies;
     out["recovered_bodies"] = s.recovered_bodies;
     out["predict_seconds"] = s.predict_seconds;

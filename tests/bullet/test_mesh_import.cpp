@@ -101,7 +101,7 @@ TEST(ImportMesh, ASoupWithFlippedShellsBecomesTheClosedMesh) {
   EXPECT_EQ(imported.defects.inverted_shells, 1);
   EXPECT_NEAR(mesh_inertia(imported, MeshInertia::kVolume).mass, 2.0, 1e-12);
   ASSERT_EQ(warnings.size(), 1u);
-  EXPECT_NE(warnings[0].find("mesh 'pair.stl': 2 shells"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("mesh 'pair.stl' (72 vertices): 2 shells"), std::string::npos) << warnings[0];
 }
 
 TEST(ImportMesh, AnOpenMeshIsWrappedOrHulledAndWeighedByTheChosenMode) {

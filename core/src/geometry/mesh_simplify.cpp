@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <vector>
 
 #include "fignet/error.h"
@@ -28,6 +29,12 @@ TriangleMesh compact(const TriangleMesh& mesh, const std::vector<unsigned>& indi
   MeshOptions options;
   options.degenerate_faces = DegenerateFaces::kDrop;
   return TriangleMesh(mesh.name(), std::move(vertices), std::move(faces), options);
+}
+
+// The result with its closedness recorded.
+SimplifiedMesh finished(SimplifiedMesh result) {
+  result.closed = result.mesh.is_closed();
+  return result;
 }
 
 }  // namespace
@@ -59,40 +66,50 @@ SimplifiedMesh simplify_mesh(const TriangleMesh& mesh, const SimplifyOptions& op
       indices[static_cast<size_t>(3 * f + k)] = static_cast<unsigned>(mesh.faces()(f, k));
   const double scale = meshopt_simplifyScale(positions.data(), mesh.num_vertices(), 12);
 
-  // The budget is in vertices, meshoptimizer's target in indices: start from the faces a closed
-  // mesh of that many vertices has (about twice as many) and tighten until the budget holds or
-  // the tolerance stops it. A closed mesh must stay closed: an attempt that leaves a non-manifold
-  // edge is retried at a slightly different target.
+  // The budget is in vertices, meshoptimizer's target in faces (a closed mesh has about twice
+  // as many faces as vertices). Edge collapse may leave a closed mesh with a non-manifold edge at
+  // one target and not at a nearby one, and a closed mesh must stay closed: targets are swept
+  // downward from the budget in 5 % steps, and the first closed attempt within the budget wins.
+  // When the tolerance stops every attempt above the budget, the closed one with the fewest
+  // vertices does.
   const bool closed = mesh.is_closed();
-  double target_faces = 2.0 * options.max_vertices;
   std::vector<unsigned> simplified(indices.size());
-  size_t previous = 0;
-  for (int attempt = 0; attempt < 16; ++attempt) {
+  // One attempt at `target_faces`; true when it gave a usable mesh within the budget.
+  const auto attempt = [&](double target_faces, size_t& count) {
+    target_faces = std::min(target_faces, static_cast<double>(mesh.num_faces()));
     float error = 0.0f;
-    const size_t count = meshopt_simplify(
-        simplified.data(), indices.data(), indices.size(), positions.data(),
-        static_cast<size_t>(mesh.num_vertices()), 12, 3 * static_cast<size_t>(target_faces),
-        static_cast<float>(options.tolerance), 0, &error);
-    if (count == 0 || count == indices.size()) break;  // nothing left, or nothing removed
+    count = meshopt_simplify(simplified.data(), indices.data(), indices.size(), positions.data(),
+                             static_cast<size_t>(mesh.num_vertices()), 12,
+                             3 * static_cast<size_t>(target_faces),
+                             static_cast<float>(options.tolerance), 0, &error);
+    if (count == 0 || count == indices.size()) return false;
     TriangleMesh candidate = compact(
         mesh,
         std::vector<unsigned>(simplified.begin(), simplified.begin() + static_cast<long>(count)));
-    const int vertices = candidate.num_vertices();
-    const bool usable = !closed || candidate.is_closed();
-    const bool within = vertices <= options.max_vertices;
-    if (usable) {
+    if (closed && !candidate.is_closed()) return false;
+    const bool within = candidate.num_vertices() <= options.max_vertices;
+    if (within || !result.changed || candidate.num_vertices() < result.mesh.num_vertices()) {
       result.mesh = std::move(candidate);
       result.error = static_cast<double>(error) * scale;
       result.changed = true;
-      if (within) break;
     }
-    // The tolerance stopped it: a smaller target gives the same mesh.
-    if (!within && count == previous) break;
+    return within;
+  };
+  // Downward from the budget until an attempt fits (or the tolerance holds the count still)...
+  size_t count = 0, previous = 0;
+  int unchanged = 0;
+  for (int step = 0; step < 40 && unchanged < 3; ++step) {
+    if (attempt(2.0 * options.max_vertices * std::pow(0.95, step), count))
+      return finished(std::move(result));
+    unchanged = count == previous ? unchanged + 1 : 0;
     previous = count;
-    target_faces *= within ? 0.95 : 0.9 * options.max_vertices / vertices;
   }
-  result.closed = result.mesh.is_closed();
-  return result;
+  // ...then, when no attempt there stayed closed, upward until one does.
+  for (int step = 1; step <= 30 && !result.changed; ++step) {
+    attempt(2.0 * options.max_vertices * std::pow(1.1, step), count);
+    if (count == indices.size()) break;
+  }
+  return finished(std::move(result));
 }
 
 }  // namespace fignet

@@ -31,6 +31,10 @@ void write_object(H5::Group group, const TrajectoryObject& object) {
   write_attribute(group, "friction", object.properties.friction);
   write_attribute(group, "restitution", object.properties.restitution);
   write_attribute(group, "kinematic", static_cast<long long>(object.kinematic));
+  if (object.inertia) {
+    for (int k = 0; k < 3; ++k)
+      write_attribute(group, fmt::format("inertia_{}", "xyz"[k]), (*object.inertia)[k]);
+  }
   hdf5::write_doubles(group, "rest_vertices", mesh.vertices().data(),
                       {size(mesh.num_vertices()), 3});
   const H5::DataSpace space(2, std::vector<hsize_t>{size(mesh.num_faces()), 3}.data());
@@ -94,6 +98,16 @@ TrajectoryObject read_object(const H5::Group& group, const std::string& where) {
   object.properties = {hdf5::read_double(group, "mass"), hdf5::read_double(group, "friction"),
                        hdf5::read_double(group, "restitution")};
   object.kinematic = hdf5::read_integer(group, "kinematic") != 0;
+  if (group.attrExists("inertia_x")) {
+    Vec3 inertia;
+    for (int k = 0; k < 3; ++k)
+      inertia[k] = hdf5::read_double(group, fmt::format("inertia_{}", "xyz"[k]));
+    if (!inertia.allFinite() || (inertia.array() < 0.0).any()) {
+      throw FileError(fmt::format("{}: inertia ({}, {}, {}) must be finite and >= 0", where,
+                                  inertia.x(), inertia.y(), inertia.z()));
+    }
+    object.inertia = inertia;
+  }
   Points vertices = read_rows(group, "rest_vertices", 0, 3, where);
   if (!group.nameExists("faces"))
     throw FileError(fmt::format("{}: missing dataset 'faces'", where));

@@ -20,6 +20,10 @@ inline constexpr double kRestSpeed = 0.05;  // m/s
 struct TrajectoryObject {
   std::shared_ptr<const TriangleMesh> mesh;  // rest mesh in the centre-of-mass frame
   StaticProperties properties;
+  // Principal moments of inertia (kg·m²) about the mesh frame's axes, when recorded: the mesh's
+  // own uniform-density inertia differs from it when mass came from a convex hull, a shell or a
+  // finer mesh than the one stored (fignet generate --assets).
+  std::optional<Vec3> inertia;
   bool kinematic = false;
   std::vector<Pose> poses;  // one per frame
   // Per frame, when recorded (empty otherwise): centre-of-mass velocity and angular velocity.
