@@ -140,6 +140,28 @@ TEST_F(Urdf, MeshesResolveRelativePackageAndScale) {
   EXPECT_EQ(load_urdf(write_urdf(body), options).size(), 1u);
 }
 
+// An open mesh (a box with one side missing) in a link with <inertial>: the link takes its mass
+// from the file and its collision piece is the closed surface around the mesh; one warning.
+TEST_F(Urdf, AnOpenMeshLoadsThroughItsRepairedSurface) {
+  const TriangleMesh box = make_box(Vec3(0.5, 0.5, 0.5), 2);
+  write_obj(TriangleMesh("cup", box.vertices(), box.faces().topRows(box.num_faces() - 8)),
+            "cup.obj");
+  const auto path = write_urdf(R"(<link name="cup">
+    <inertial><mass value="3"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+    <collision><geometry><mesh filename="cup.obj"/></geometry></collision></link>)");
+  std::vector<std::string> warnings;
+  UrdfOptions options;
+  options.mesh.warn = [&](const std::string& line) { warnings.push_back(line); };
+  const auto bodies = load_urdf(path, options);
+  ASSERT_EQ(bodies.size(), 1u);
+  EXPECT_NEAR(bodies[0].body.properties.mass, 3.0, 1e-12);
+  EXPECT_TRUE(bodies[0].body.mesh->is_closed());
+  EXPECT_LE(bodies[0].body.mesh->num_vertices(), 1000);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("cup.obj"), std::string::npos);
+  EXPECT_NE(warnings[0].find("open edges"), std::string::npos);
+}
+
 TEST_F(Urdf, ErrorsNameTheFileAndTheCulprit) {
   EXPECT_NE(error_of([&] { load_urdf(dir_ / "missing.urdf"); }).find("cannot be opened"),
             std::string::npos);

@@ -95,13 +95,14 @@ SimplifiedMesh simplify_mesh(const TriangleMesh& mesh, const SimplifyOptions& op
     }
     return within;
   };
-  // Downward from the budget until an attempt fits (or the tolerance holds the count still)...
+  // Downward from the budget until an attempt fits, or the tolerance holds the result where it
+  // was (a smaller target gives the same mesh)...
   size_t count = 0, previous = 0;
-  int unchanged = 0;
-  for (int step = 0; step < 40 && unchanged < 3; ++step) {
-    if (attempt(2.0 * options.max_vertices * std::pow(0.95, step), count))
+  for (int step = 0; step < 40; ++step) {
+    if (attempt(2.0 * options.max_vertices * std::pow(0.95, step), count)) {
       return finished(std::move(result));
-    unchanged = count == previous ? unchanged + 1 : 0;
+    }
+    if (count == previous) break;
     previous = count;
   }
   // ...then, when no attempt there stayed closed, upward until one does.
