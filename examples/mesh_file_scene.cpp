@@ -1,6 +1,8 @@
 // Bodies from mesh files (through assimp) dropped on a floor, in native Bullet or, with a model
-// file, in FIGNet: an L-shaped OBJ block (non-convex: split into convex parts by HACD) and an STL
-// octahedron. Any file assimp reads works the same way, given on the command line after the model.
+// file, in FIGNet: an L-shaped OBJ block (non-convex: split into convex parts by HACD), an STL
+// octahedron and an open cup (no top: FIGNet sees its alpha wrap, mass from its convex hull, and
+// one warning line says so). Any file assimp reads works the same way, given on the command line
+// after the model.
 //
 //   build/release/examples/example_mesh_file_scene                           # native Bullet
 //   build/release/examples/example_mesh_file_scene models/movi-a.h5          # FIGNet
@@ -25,11 +27,13 @@ int main(int argc, char** argv) try {
 
   std::vector<std::string> files(argv + std::min(argc, 2), argv + argc);
   if (files.empty()) {
-    files = {FIGNET_EXAMPLE_ASSETS "/l_block.obj", FIGNET_EXAMPLE_ASSETS "/octahedron.stl"};
+    files = {FIGNET_EXAMPLE_ASSETS "/l_block.obj", FIGNET_EXAMPLE_ASSETS "/octahedron.stl",
+             FIGNET_EXAMPLE_ASSETS "/open_cup.obj"};
   }
   std::vector<std::pair<std::string, const btRigidBody*>> labelled;
   for (size_t i = 0; i < files.size(); ++i) {
-    // One call from a file to a body: 500 kg/m³ wood, mass from the mesh's volume.
+    // One call from a file to a body: 500 kg/m³ wood, mass from the mesh's volume (its convex
+    // hull's when the mesh is open).
     BodyMaterial wood;
     wood.density = 500.0;
     wood.friction = 0.6;

@@ -39,6 +39,8 @@ std::string ImportedMesh::actions() const {
     done.push_back(
         fmt::format("FIGNet sees its {} ({} vertices)", repair, vertices_before_simplification));
   }
+  if (hull_collision)
+    done.push_back("Bullet collides its convex hull (HACD fails on its thin walls)");
   if (simplified()) {
     done.push_back(fmt::format("simplified for the graph from {} to {} vertices (deviation {:.3g})",
                                vertices_before_simplification, surface.num_vertices(),
@@ -60,6 +62,21 @@ TriangleMesh hull_of(const TriangleMesh& mesh) {
   return hull.finish(mesh.name());
 }
 
+// Whether HACD's pieces of a repaired `surface` stand for it: at most 256 of them, their hulls
+// covering at least half its volume (they overlap, so more is fine).
+bool thin_walls_covered(const std::vector<Points>& parts, const TriangleMesh& surface) {
+  if (parts.empty()) return true;  // convex: one hull is exact
+  if (parts.size() > 256) return false;
+  double covered = 0.0;
+  for (const Points& part : parts) {
+    try {
+      covered += convex_hull_volume(part);
+    } catch (const MeshError&) {  // a flat piece covers nothing
+    }
+  }
+  return covered >= 0.5 * compute_mass_properties(surface).volume;
+}
+
 }  // namespace
 
 ImportedMesh import_mesh(const TriangleMesh& mesh, const MeshImportOptions& options) {
@@ -69,7 +86,7 @@ ImportedMesh import_mesh(const TriangleMesh& mesh, const MeshImportOptions& opti
   }
   // Weld, drop degenerate and repeated faces, wind each shell consistently and outward.
   CleanedMesh cleaned = clean_mesh(mesh.name(), mesh.vertices(), mesh.faces());
-  ImportedMesh result{cleaned.mesh, cleaned.mesh, cleaned.defects, "", 0, 0.0, {}};
+  ImportedMesh result{cleaned.mesh, cleaned.mesh, cleaned.defects, "", 0, 0.0, {}, false};
   const bool closed = cleaned.defects.closed() && cleaned.mesh.is_closed();
 
   // What the graph sees: the mesh when closed, otherwise a closed surface around it.
@@ -99,7 +116,13 @@ ImportedMesh import_mesh(const TriangleMesh& mesh, const MeshImportOptions& opti
   // the full mesh is far below HACD's own concavity tolerance; a convex mesh keeps the exact hull
   // of all its vertices.
   if (result.surface.is_closed()) result.convex_parts = decompose_into_convex_parts(result.surface);
-  if (result.convex_parts.empty() && result.simplified()) {
+  // HACD fails on the thin walls a wrap gives an open surface wider than alpha (a cup): hundreds
+  // of slivers whose hulls cover a fraction of the wall. Such a body collides as its hull.
+  if (!result.repair.empty() && !thin_walls_covered(result.convex_parts, result.surface)) {
+    result.convex_parts.clear();
+    result.hull_collision = true;
+  }
+  if (result.convex_parts.empty() && (result.simplified() || result.hull_collision)) {
     result.convex_parts.push_back(result.cleaned.vertices());
   }
 

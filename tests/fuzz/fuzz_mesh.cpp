@@ -1,12 +1,14 @@
 // libFuzzer harness: arbitrary bytes as a triangle mesh (vertex count, vertices as floats, faces
 // as indices). Construction may fail only with a MeshError; a mesh that is accepted must go
 // through mass properties (when closed) and the face-pair search against a cube without a crash.
+// The same bytes as a file's triangles go through clean_mesh, shell properties and simplify_mesh.
 #include <cstdint>
 #include <cstring>
 #include <vector>
 
 #include "fignet/error.h"
 #include "fignet/geometry/mass_properties.h"
+#include "fignet/geometry/mesh_repair.h"
 #include "fignet/geometry/shapes.h"
 #include "fignet/graph/graph_builder.h"
 
@@ -39,6 +41,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   fignet::Triangles triangles(static_cast<Eigen::Index>(faces.size()), 3);
   for (size_t f = 0; f < faces.size(); ++f) {
     for (int c = 0; c < 3; ++c) triangles(static_cast<Eigen::Index>(f), c) = faces[f][c];
+  }
+  try {
+    const fignet::CleanedMesh cleaned = fignet::clean_mesh("fuzz", points, triangles);
+    (void)cleaned.defects.summary();
+    (void)fignet::compute_shell_properties(cleaned.mesh);
+    if (cleaned.mesh.is_closed()) (void)fignet::compute_mass_properties(cleaned.mesh);
+    (void)fignet::simplify_mesh(cleaned.mesh, {4, 0.05});
+  } catch (const fignet::Error&) {
   }
   try {
     fignet::MeshOptions options;

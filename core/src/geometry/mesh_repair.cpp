@@ -67,11 +67,14 @@ int weld(const Points& vertices, double tolerance, std::vector<int>& target) {
     }
   };
   std::unordered_map<std::array<long long, 3>, std::vector<int>, CellHash> grid;
+  // Cells counted from the box's corner: at most diagonal / tolerance of them along an axis.
+  const Vec3 corner = vertices.colwise().minCoeff().transpose();
   int merged = 0;
   for (Eigen::Index v = 0; v < n; ++v) {
     const Vec3 p = vertices.row(v).transpose();
     std::array<long long, 3> cell;
-    for (int k = 0; k < 3; ++k) cell[k] = static_cast<long long>(std::floor(p[k] / tolerance));
+    for (int k = 0; k < 3; ++k)
+      cell[k] = static_cast<long long>(std::floor((p[k] - corner[k]) / tolerance));
     int found = -1;
     for (long long dx = -1; dx <= 1 && found < 0; ++dx)
       for (long long dy = -1; dy <= 1 && found < 0; ++dy)

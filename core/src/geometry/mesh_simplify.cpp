@@ -50,6 +50,10 @@ SimplifiedMesh simplify_mesh(const TriangleMesh& mesh, const SimplifyOptions& op
   }
   SimplifiedMesh result{mesh, 0.0, false, mesh.is_closed()};
   if (mesh.num_vertices() <= options.max_vertices) return result;
+  // meshoptimizer works in float: a mesh whose extent float cannot hold stays as it is.
+  const double extent =
+      (mesh.vertices().colwise().maxCoeff() - mesh.vertices().colwise().minCoeff()).maxCoeff();
+  if (!(extent < 1e30)) return result;
 
   // meshoptimizer works in float, relative to the mesh's extent; positions are taken about the
   // box centre so a mesh far from the origin keeps its precision.

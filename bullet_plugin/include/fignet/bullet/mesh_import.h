@@ -51,6 +51,9 @@ struct ImportedMesh {
   // Bullet's collision shape: the convex pieces of the full-resolution mesh; empty: the hull of
   // `surface`'s vertices is exact.
   std::vector<Points> convex_parts;
+  // HACD could not decompose the repaired surface (the thin walls of an open mesh wider than
+  // alpha): Bullet collides the convex hull of the mesh instead.
+  bool hull_collision = false;
 
   bool simplified() const { return vertices_before_simplification > surface.num_vertices(); }
   // What was done, for the warning line ("" when the mesh needed nothing).
