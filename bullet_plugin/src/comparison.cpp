@@ -27,7 +27,7 @@ SceneSpec scene_from_trajectory(const Trajectory& trajectory) {
     BodySpec body;
     if (object.inertia) {
       // Recorded inertia: the mesh's frame is the body's, whatever the mesh's own volume says.
-      const std::vector<Points> parts = decompose_into_convex_parts(*object.mesh);
+      const std::vector<Points> parts = collision_parts(*object.mesh);
       body.convex_parts = parts.size() > 1 ? parts : std::vector<Points>{};
       body.inertia = *object.inertia;
     } else {
@@ -36,7 +36,7 @@ SceneSpec scene_from_trajectory(const Trajectory& trajectory) {
       const double volume = compute_mass_properties(*object.mesh).volume;
       const double density = object.kinematic ? 1.0 : object.properties.mass / volume;
       body = make_body(*object.mesh, density, object.properties.friction,
-                       object.properties.restitution, decompose_into_convex_parts(*object.mesh));
+                       object.properties.restitution, collision_parts(*object.mesh));
     }
     // The rest mesh is already in the body's frame: keep the recorded mesh itself.
     body.mesh = object.mesh;

@@ -63,4 +63,21 @@ std::vector<Points> decompose_into_convex_parts(const TriangleMesh& mesh,
   return parts;
 }
 
+std::vector<Points> collision_parts(const TriangleMesh& mesh, bool* hacd_failed,
+                                    const ConvexDecompositionOptions& options) {
+  if (hacd_failed) *hacd_failed = false;
+  std::vector<Points> parts = decompose_into_convex_parts(mesh, options);
+  if (parts.empty()) return parts;  // convex: one hull is exact
+  double covered = 0.0;
+  for (const Points& part : parts) {
+    try {
+      covered += convex_hull_volume(part);
+    } catch (const MeshError&) {  // a flat sliver covers nothing
+    }
+  }
+  if (parts.size() <= 256 && covered >= 0.5 * compute_mass_properties(mesh).volume) return parts;
+  if (hacd_failed) *hacd_failed = true;
+  return {};
+}
+
 }  // namespace fignet::bullet

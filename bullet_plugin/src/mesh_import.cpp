@@ -62,21 +62,6 @@ TriangleMesh hull_of(const TriangleMesh& mesh) {
   return hull.finish(mesh.name());
 }
 
-// Whether HACD's pieces of a repaired `surface` stand for it: at most 256 of them, their hulls
-// covering at least half its volume (they overlap, so more is fine).
-bool thin_walls_covered(const std::vector<Points>& parts, const TriangleMesh& surface) {
-  if (parts.empty()) return true;  // convex: one hull is exact
-  if (parts.size() > 256) return false;
-  double covered = 0.0;
-  for (const Points& part : parts) {
-    try {
-      covered += convex_hull_volume(part);
-    } catch (const MeshError&) {  // a flat piece covers nothing
-    }
-  }
-  return covered >= 0.5 * compute_mass_properties(surface).volume;
-}
-
 }  // namespace
 
 ImportedMesh import_mesh(const TriangleMesh& mesh, const MeshImportOptions& options) {
@@ -115,12 +100,8 @@ ImportedMesh import_mesh(const TriangleMesh& mesh, const MeshImportOptions& opti
   // Bullet's collision shape: convex pieces (HACD) of the closed surface, whose deviation from
   // the full mesh is far below HACD's own concavity tolerance; a convex mesh keeps the exact hull
   // of all its vertices.
-  if (result.surface.is_closed()) result.convex_parts = decompose_into_convex_parts(result.surface);
-  // HACD fails on the thin walls a wrap gives an open surface wider than alpha (a cup): hundreds
-  // of slivers whose hulls cover a fraction of the wall. Such a body collides as its hull.
-  if (!result.repair.empty() && !thin_walls_covered(result.convex_parts, result.surface)) {
-    result.convex_parts.clear();
-    result.hull_collision = true;
+  if (result.surface.is_closed()) {
+    result.convex_parts = collision_parts(result.surface, &result.hull_collision);
   }
   if (result.convex_parts.empty() && (result.simplified() || result.hull_collision)) {
     result.convex_parts.push_back(result.cleaned.vertices());

@@ -28,4 +28,12 @@ double convex_hull_volume(const Points& points);
 std::vector<Points> decompose_into_convex_parts(const TriangleMesh& mesh,
                                                 const ConvexDecompositionOptions& options = {});
 
+// The pieces Bullet should collide a closed mesh as: decompose_into_convex_parts, unless HACD
+// failed on it: more than 256 pieces, or pieces whose hulls cover less than half the mesh's
+// volume (HACD splits thin walls, such as an alpha wrap around an open cup, into slivers that
+// cover a fraction of them). Then none, and `hacd_failed` (when given) is set: the mesh collides
+// as its convex hull.
+std::vector<Points> collision_parts(const TriangleMesh& mesh, bool* hacd_failed = nullptr,
+                                    const ConvexDecompositionOptions& options = {});
+
 }  // namespace fignet::bullet
