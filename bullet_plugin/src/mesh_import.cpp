@@ -40,7 +40,7 @@ std::string ImportedMesh::actions() const {
         fmt::format("FIGNet sees its {} ({} vertices)", repair, vertices_before_simplification));
   }
   if (hull_collision)
-    done.push_back("Bullet collides its convex hull (HACD fails on its thin walls)");
+    done.push_back("Bullet collides its convex hull (HACD's pieces cover too little of it)");
   if (simplified()) {
     done.push_back(fmt::format("simplified for the graph from {} to {} vertices (deviation {:.3g})",
                                vertices_before_simplification, surface.num_vertices(),

@@ -51,8 +51,8 @@ struct ImportedMesh {
   // Bullet's collision shape: the convex pieces of the full-resolution mesh; empty: the hull of
   // `surface`'s vertices is exact.
   std::vector<Points> convex_parts;
-  // HACD could not decompose the repaired surface (the thin walls of an open mesh wider than
-  // alpha): Bullet collides the convex hull of the mesh instead.
+  // HACD's pieces did not stand for the surface (they cover less than half of it, as on the thin
+  // walls of an open mesh's wrap, or number over 256): Bullet collides the mesh's convex hull.
   bool hull_collision = false;
 
   bool simplified() const { return vertices_before_simplification > surface.num_vertices(); }
