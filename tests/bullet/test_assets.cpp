@@ -70,7 +70,8 @@ TEST_F(Assets, LoadBodyTakesAMassOrADensity) {
   const BodySpec hull = load_body(open_path, {1.0, {}, 0.5, 0.1}, 1.0, options);
   EXPECT_NEAR(hull.properties.mass, 8.0, 1e-9);
   ASSERT_EQ(warnings.size(), 1u);
-  EXPECT_NE(warnings[0].find("open.obj' (56 vertices): 4 open edges"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("open.obj' (56 vertices): 4 open edges"), std::string::npos)
+      << warnings[0];
   EXPECT_TRUE(hull.mesh->is_closed());  // FIGNet sees a closed surface
   options.inertia = MeshInertia::kShell;
   EXPECT_NEAR(load_body(open_path, {1.0, {}, 0.5, 0.1}, 1.0, options).properties.mass,
