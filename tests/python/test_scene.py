@@ -85,3 +85,41 @@ def test_mesh_files_load_as_bodies(source_dir):
     scene.add_mesh_file(meshes[0], position=(0, 0, 5))
     scene.step(1)
     assert scene.positions[0, 2] < 5
+
+
+def sphere(radius, rings, segments):
+    """A UV sphere: rings - 1 latitude circles of `segments` vertices and two poles."""
+    vertices = [[0.0, 0.0, radius]]
+    for i in range(1, rings):
+        theta = np.pi * i / rings
+        for j in range(segments):
+            phi = 2 * np.pi * j / segments
+            vertices.append([radius * np.sin(theta) * np.cos(phi),
+                             radius * np.sin(theta) * np.sin(phi), radius * np.cos(theta)])
+    vertices.append([0.0, 0.0, -radius])
+    faces, last = [], len(vertices) - 1
+    for j in range(segments):
+        faces.append([0, 1 + j, 1 + (j + 1) % segments])
+        base = 1 + (rings - 2) * segments
+        faces.append([last, base + (j + 1) % segments, base + j])
+    for i in range(rings - 2):
+        for j in range(segments):
+            a, b = 1 + i * segments + j, 1 + i * segments + (j + 1) % segments
+            faces.append([a, a + segments, b])
+            faces.append([b, a + segments, b + segments])
+    return np.array(vertices), np.array(faces)
+
+
+def test_a_fine_mesh_enters_the_graph_within_the_node_budget(model):
+    vertices, faces = sphere(0.5, 40, 40)  # 1562 vertices
+    nodes = {}
+    for budget in (None, 0):
+        scene = fignet.Scene(model, free_flight=False, graph_vertices=budget)
+        scene.add_body(vertices, faces, mass=5.0, position=(0, 0, 0.51), name="ball",
+                       max_graph_vertices=0)
+        scene.add_floor()
+        scene.step(1)
+        nodes[budget] = scene.last_step_stats()["mesh_nodes"]
+    # The model's resolution (at most 1000 when its file predates it) within 2 %, or none.
+    assert nodes[None] < 400
+    assert nodes[0] >= len(vertices)
