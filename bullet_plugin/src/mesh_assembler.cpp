@@ -36,23 +36,10 @@ void MeshAssembler::append(const TriangleMesh& mesh, const std::function<Vec3(co
 }
 
 TriangleMesh MeshAssembler::finish(std::string name) const {
-  // Only vertices that faces use: every vertex becomes a graph node.
-  std::vector<int> renumber(points_.size(), -1);
-  int used = 0;
-  for (const auto& face : faces_)
-    for (int v : face)
-      if (renumber[v] < 0) renumber[v] = used++;
-  Points vertices(used, 3);
+  Points points(static_cast<Eigen::Index>(points_.size()), 3);
   for (size_t v = 0; v < points_.size(); ++v)
-    if (renumber[v] >= 0) vertices.row(renumber[v]) = points_[v].transpose();
-  Triangles faces(static_cast<Eigen::Index>(faces_.size()), 3);
-  for (size_t f = 0; f < faces_.size(); ++f) {
-    faces.row(static_cast<Eigen::Index>(f)) << renumber[faces_[f][0]], renumber[faces_[f][1]],
-        renumber[faces_[f][2]];
-  }
-  MeshOptions options;
-  options.degenerate_faces = DegenerateFaces::kDrop;
-  return TriangleMesh(std::move(name), std::move(vertices), std::move(faces), options);
+    points.row(static_cast<Eigen::Index>(v)) = points_[v].transpose();
+  return mesh_of_used_vertices(std::move(name), points, faces_);
 }
 
 MeshAssembler convex_hull_triangles(const Points& points) {

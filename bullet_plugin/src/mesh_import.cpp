@@ -72,7 +72,7 @@ ImportedMesh import_mesh(const TriangleMesh& mesh, const MeshImportOptions& opti
   // Weld, drop degenerate and repeated faces, wind each shell consistently and outward.
   CleanedMesh cleaned = clean_mesh(mesh.name(), mesh.vertices(), mesh.faces());
   ImportedMesh result{cleaned.mesh, cleaned.mesh, cleaned.defects, "", 0, 0.0, {}, false};
-  const bool closed = cleaned.defects.closed() && cleaned.mesh.is_closed();
+  const bool closed = result.closed();
 
   // What the graph sees: the mesh when closed, otherwise a closed surface around it.
   if (!closed && options.repair) {
@@ -122,7 +122,7 @@ ImportedMesh import_mesh(const TriangleMesh& mesh, const MeshImportOptions& opti
 }
 
 UnitInertia mesh_inertia(const ImportedMesh& mesh, MeshInertia inertia) {
-  const bool closed = mesh.defects.closed() && mesh.cleaned.is_closed();
+  const bool closed = mesh.closed();
   if (inertia == MeshInertia::kVolume && !closed) {
     throw MeshError(fmt::format(
         "mesh '{}': not closed ({}), so it has no volume; choose convex or shell inertia",

@@ -106,6 +106,28 @@ TriangleMesh::TriangleMesh(std::string name, Points vertices, Triangles faces,
   }
 }
 
+TriangleMesh mesh_of_used_vertices(std::string name, const Points& vertices,
+                                   std::span<const std::array<int, 3>> faces) {
+  // Every vertex becomes a graph node: keep only those the faces use.
+  std::vector<int> renumber(static_cast<size_t>(vertices.rows()), -1);
+  int used = 0;
+  for (const auto& face : faces)
+    for (int v : face)
+      if (renumber[static_cast<size_t>(v)] < 0) renumber[static_cast<size_t>(v)] = used++;
+  Points kept(used, 3);
+  for (Eigen::Index v = 0; v < vertices.rows(); ++v)
+    if (renumber[static_cast<size_t>(v)] >= 0)
+      kept.row(renumber[static_cast<size_t>(v)]) = vertices.row(v);
+  Triangles triangles(static_cast<Eigen::Index>(faces.size()), 3);
+  for (size_t f = 0; f < faces.size(); ++f) {
+    triangles.row(static_cast<Eigen::Index>(f)) << renumber[static_cast<size_t>(faces[f][0])],
+        renumber[static_cast<size_t>(faces[f][1])], renumber[static_cast<size_t>(faces[f][2])];
+  }
+  MeshOptions options;
+  options.degenerate_faces = DegenerateFaces::kDrop;
+  return TriangleMesh(std::move(name), std::move(kept), std::move(triangles), options);
+}
+
 bool TriangleMesh::is_closed() const {
   // Each directed half-edge must appear once, and its twin (reversed) exactly once.
   std::map<std::pair<std::int32_t, std::int32_t>, int> half_edges;

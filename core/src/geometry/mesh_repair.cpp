@@ -233,23 +233,7 @@ CleanedMesh clean_mesh(std::string name, const Points& vertices, const Triangles
     }
   }
 
-  // Only the vertices faces use, numbered in order of first use.
-  std::vector<int> renumber(static_cast<size_t>(vertices.rows()), -1);
-  int used = 0;
-  for (const Face& face : kept)
-    for (int v : face)
-      if (renumber[v] < 0) renumber[v] = used++;
-  Points out_vertices(used, 3);
-  for (Eigen::Index v = 0; v < vertices.rows(); ++v)
-    if (renumber[v] >= 0) out_vertices.row(renumber[v]) = vertices.row(v);
-  Triangles out_faces(face_count, 3);
-  for (int f = 0; f < face_count; ++f)
-    out_faces.row(f) << renumber[kept[f][0]], renumber[kept[f][1]], renumber[kept[f][2]];
-  MeshOptions mesh_options;
-  mesh_options.degenerate_faces = DegenerateFaces::kDrop;
-  return {
-      TriangleMesh(std::move(name), std::move(out_vertices), std::move(out_faces), mesh_options),
-      defects};
+  return {mesh_of_used_vertices(std::move(name), vertices, kept), defects};
 }
 
 }  // namespace fignet

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -13,22 +14,11 @@ namespace fignet {
 
 namespace {
 
-// The faces `indices` names, with only the vertices they use (numbered in order of first use).
+// The mesh of the faces `indices` names (three per face).
 TriangleMesh compact(const TriangleMesh& mesh, const std::vector<unsigned>& indices) {
-  std::vector<int> renumber(static_cast<size_t>(mesh.num_vertices()), -1);
-  int used = 0;
-  for (unsigned v : indices)
-    if (renumber[v] < 0) renumber[v] = used++;
-  Points vertices(used, 3);
-  for (int v = 0; v < mesh.num_vertices(); ++v)
-    if (renumber[v] >= 0) vertices.row(renumber[v]) = mesh.vertices().row(v);
-  Triangles faces(static_cast<Eigen::Index>(indices.size() / 3), 3);
-  for (size_t i = 0; i < indices.size(); ++i)
-    faces(static_cast<Eigen::Index>(i / 3), static_cast<Eigen::Index>(i % 3)) =
-        renumber[indices[i]];
-  MeshOptions options;
-  options.degenerate_faces = DegenerateFaces::kDrop;
-  return TriangleMesh(mesh.name(), std::move(vertices), std::move(faces), options);
+  std::vector<std::array<int, 3>> faces(indices.size() / 3);
+  for (size_t i = 0; i < indices.size(); ++i) faces[i / 3][i % 3] = static_cast<int>(indices[i]);
+  return mesh_of_used_vertices(mesh.name(), mesh.vertices(), faces);
 }
 
 // The result with its closedness recorded.
@@ -48,17 +38,16 @@ SimplifiedMesh simplify_mesh(const TriangleMesh& mesh, const SimplifyOptions& op
     throw ConfigError(fmt::format("mesh '{}': simplification tolerance {} (must be in (0, 1])",
                                   mesh.name(), options.tolerance));
   }
-  SimplifiedMesh result{mesh, 0.0, false, mesh.is_closed()};
+  const bool closed = mesh.is_closed();
+  SimplifiedMesh result{mesh, 0.0, false, closed};
   if (mesh.num_vertices() <= options.max_vertices) return result;
-  // meshoptimizer works in float: a mesh whose extent float cannot hold stays as it is.
-  const double extent =
-      (mesh.vertices().colwise().maxCoeff() - mesh.vertices().colwise().minCoeff()).maxCoeff();
-  if (!(extent < 1e30)) return result;
-
-  // meshoptimizer works in float, relative to the mesh's extent; positions are taken about the
-  // box centre so a mesh far from the origin keeps its precision.
-  const Vec3 centre =
-      0.5 * (mesh.vertices().colwise().maxCoeff() + mesh.vertices().colwise().minCoeff());
+  // meshoptimizer works in float, relative to the mesh's extent: a mesh whose extent float cannot
+  // hold stays as it is, and positions are taken about the box centre so a mesh far from the
+  // origin keeps its precision.
+  const Vec3 lower = mesh.vertices().colwise().minCoeff(),
+             upper = mesh.vertices().colwise().maxCoeff();
+  if (!((upper - lower).maxCoeff() < 1e30)) return result;
+  const Vec3 centre = 0.5 * (upper + lower);
   std::vector<float> positions(static_cast<size_t>(3 * mesh.num_vertices()));
   for (int v = 0; v < mesh.num_vertices(); ++v)
     for (int k = 0; k < 3; ++k)
@@ -76,7 +65,6 @@ SimplifiedMesh simplify_mesh(const TriangleMesh& mesh, const SimplifyOptions& op
   // downward from the budget in 5 % steps, and the first closed attempt within the budget wins.
   // When the tolerance stops every attempt above the budget, the closed one with the fewest
   // vertices does.
-  const bool closed = mesh.is_closed();
   std::vector<unsigned> simplified(indices.size());
   // One attempt at `target_faces`; true when it gave a usable mesh within the budget.
   const auto attempt = [&](double target_faces, size_t& count) {

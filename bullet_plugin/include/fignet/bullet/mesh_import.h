@@ -56,6 +56,8 @@ struct ImportedMesh {
   bool hull_collision = false;
 
   bool simplified() const { return vertices_before_simplification > surface.num_vertices(); }
+  // The cleaned mesh encloses a volume (every edge between two faces of opposite winding).
+  bool closed() const { return defects.closed() && cleaned.is_closed(); }
   // What was done, for the warning line ("" when the mesh needed nothing).
   std::string actions() const;
 };

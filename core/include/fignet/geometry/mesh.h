@@ -3,6 +3,8 @@
 // and immutable afterwards.
 #pragma once
 
+#include <array>
+#include <span>
 #include <string>
 
 #include "fignet/geometry/types.h"
@@ -55,6 +57,12 @@ class TriangleMesh {
   Points face_normals_;
   int dropped_faces_ = 0;
 };
+
+// The mesh of `faces` (indices into `vertices`) with only the vertices they use, numbered in order
+// of first use, and zero-area faces dropped (DegenerateFaces::kDrop): what loose triangles,
+// welding, repair and simplification leave. Throws MeshError as TriangleMesh does.
+TriangleMesh mesh_of_used_vertices(std::string name, const Points& vertices,
+                                   std::span<const std::array<int, 3>> faces);
 
 // Unit normal of triangle (a, b, c) by the right-hand rule; zero for a degenerate triangle.
 Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c);
