@@ -24,7 +24,8 @@ fi
 echo "generate rerun: ok"
 
 # train: a checkpoint every step, killed mid-run, then resumed to two steps past the checkpoint.
-"$fignet" train --data "$work/set.h5" --preset small --threads 1 --steps 100000 \
+"$fignet" train --data "$work/set.h5" --preset small --set batch_size=4 --set statistics_warmup=0 \
+    --threads 1 --steps 100000 \
     --checkpoint-minutes 0 --out "$work/model.h5" >/dev/null 2>&1 &
 pid=$!
 while [ ! -e "$work/model.h5.ckpt.h5" ]; do sleep 0.2; done

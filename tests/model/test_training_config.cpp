@@ -43,6 +43,26 @@ TEST(TrainingConfig, SettingsOverrideOneFieldAndAPresetResetsTheModel) {
   EXPECT_EQ(config.model.message_passing_steps, 5);
 }
 
+// The presets train with the study's recipe; the structs' defaults stay the first recipe's, which
+// is how a file without one of these fields reads.
+TEST(TrainingConfig, PresetsCarryTheRecipeAndTheDefaultsStayTheOldOne) {
+  for (const char* name : {"small", "paper"}) {
+    const TrainingConfig preset = TrainingConfig::preset_named(name);
+    TrainingConfig old;
+    old.model = ModelConfig::preset_named(name);
+    old.trainer.adam.decay_steps = old.steps;
+    EXPECT_EQ(old.differing_fields(preset),
+              (std::vector<std::string>{"static_internal_edges", "log_mass", "noise",
+                                        "normalizer_max_accumulations", "batch_size",
+                                        "gradient_clip", "huber_delta", "statistics_warmup"}))
+        << name;
+    EXPECT_EQ(preset.field_text("noise"), "\"rigid\"");
+    EXPECT_EQ(preset.trainer.batch_size, 128);
+    EXPECT_EQ(old.trainer.batch_size, 4);
+    EXPECT_EQ(old.model.noise, NoiseKind::kVertex);
+  }
+}
+
 TEST(TrainingConfig, BadInputNamesTheField) {
   TrainingConfig config;
   EXPECT_NE(
