@@ -32,7 +32,8 @@ def resting_bodies(trajectories, frames, tolerance):
 
 def drift(model, t, o, steps):
     """Displacement after the first step and after `steps` steps, metres."""
-    scene = fignet.Scene(model, free_flight=False, sleeping=False, penetration_guard=False)
+    scene = fignet.Scene(model, free_flight=False, sleeping=False, penetration_guard=False,
+                         rest_guard=False)
     scene.add_floor(height=t.floor_height)
     scene.add_body(t.vertices(o), t.faces(o), mass=t.masses[o], friction=t.frictions[o],
                    restitution=t.restitutions[o], position=t.positions[-1, o],

@@ -9,10 +9,13 @@
 #include <numeric>
 #include <optional>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "fignet/bullet/conversions.h"
 #include "fignet/bullet/shape_mesh.h"
 #include "fignet/error.h"
+#include "fignet/geometry/triangle_distance.h"
+#include "fignet/graph/contacts.h"
 #include "fignet/graph/graph_builder.h"
 #include "fignet/rollout/rollout.h"
 
@@ -57,6 +60,71 @@ std::vector<Pose> seed_history(const Pose& current, const Vec3& linear, const Ve
   return poses;
 }
 
+// How far Bullet's collision surface lies outside the mesh the network sees: the margin of the
+// shapes that add it around their points (hulls, triangle meshes); boxes, spheres, cylinders and
+// cones keep theirs inside their dimensions.
+double margin_outside(const btCollisionShape& shape) {
+  switch (shape.getShapeType()) {
+    case CONVEX_HULL_SHAPE_PROXYTYPE:
+    case CONVEX_POINT_CLOUD_SHAPE_PROXYTYPE:
+    case CONVEX_TRIANGLEMESH_SHAPE_PROXYTYPE:
+    case TRIANGLE_MESH_SHAPE_PROXYTYPE:
+    case SCALED_TRIANGLE_MESH_SHAPE_PROXYTYPE:
+    case GIMPACT_SHAPE_PROXYTYPE:
+      return shape.getMargin();
+    case COMPOUND_SHAPE_PROXYTYPE: {
+      const auto& compound = static_cast<const btCompoundShape&>(shape);
+      double widest = 0.0;
+      for (int i = 0; i < compound.getNumChildShapes(); ++i)
+        widest = std::max(widest, margin_outside(*compound.getChildShape(i)));
+      return widest;
+    }
+    default:
+      return 0.0;
+  }
+}
+
+// Whether `point` lies within `margin` of the convex hull of `support` (2D, Andrew's monotone
+// chain). Reorders `support`.
+bool within_hull(std::vector<Eigen::Vector2d>& support, const Eigen::Vector2d& point,
+                 double margin) {
+  auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
+  };
+  std::sort(support.begin(), support.end(), [](const auto& a, const auto& b) {
+    return std::tie(a.x(), a.y()) < std::tie(b.x(), b.y());
+  });
+  std::vector<Eigen::Vector2d> hull(2 * support.size());
+  size_t k = 0;
+  for (size_t i = 0; i < support.size(); ++i) {  // lower hull
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], support[i]) <= 0) --k;
+    hull[k++] = support[i];
+  }
+  for (size_t i = support.size() - 1, lower = k + 1; i-- > 0;) {  // upper hull
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], support[i]) <= 0) --k;
+    hull[k++] = support[i];
+  }
+  hull.resize(k > 1 ? k - 1 : k);  // counter-clockwise, the first point not repeated
+  auto distance_to_segment = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    const Eigen::Vector2d ab = b - a;
+    const double t =
+        ab.squaredNorm() > 0 ? std::clamp((point - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+    return (a + t * ab - point).norm();
+  };
+  if (hull.empty()) return false;
+  if (hull.size() == 1) return (hull[0] - point).norm() <= margin;
+  if (hull.size() == 2) return distance_to_segment(hull[0], hull[1]) <= margin;
+  bool inside = true;
+  double nearest = INFINITY;
+  for (size_t i = 0; i < hull.size(); ++i) {
+    const Eigen::Vector2d& a = hull[i];
+    const Eigen::Vector2d& b = hull[(i + 1) % hull.size()];
+    inside = inside && cross(a, b, point) >= 0;
+    nearest = std::min(nearest, distance_to_segment(a, b));
+  }
+  return inside || nearest <= margin;
+}
+
 // The node budget a world of this model uses when the options leave it to the model.
 FIGNetWorldOptions with_model_budget(FIGNetWorldOptions options, const ModelConfig& config) {
   if (options.max_graph_vertices == FIGNetWorldOptions::kModelResolution &&
@@ -99,6 +167,7 @@ struct FIGNetDynamicsWorld::Impl {
   std::vector<char> in_network;              // per moving body: predicted by the network
   std::vector<int> networked;     // moving bodies that are scene.objects[0 … n), in order
   std::vector<char> interacting;  // per scene object: has a collision edge
+  std::vector<const btCollisionObject*> scene_owners;  // per scene object: whose it is
   std::unordered_map<const btCollisionObject*, int> scene_index;
   std::unordered_map<const btCollisionObject*, int> dynamic_index;  // into dynamic_bodies
   std::unordered_map<const btCollisionObject*, int> moving_index;   // into moving
@@ -110,6 +179,23 @@ struct FIGNetDynamicsWorld::Impl {
   StepWorkspace workspace;
   std::vector<Pose> network_next;  // per scene object
   std::vector<Pose> next;          // per moving body
+  // The rest guard's scratch: bodies pushed by a force other than gravity this step, and per
+  // moving body whether it may rest, whether it is held, and its contacts.
+  struct RestContact {
+    const btCollisionObject* other;  // nullptr: the floor
+    Vec3 point, normal;              // a point of the contact; out of the other into the body
+    double friction;                 // Bullet's combined friction of the two
+  };
+  static constexpr double kFromBelow = 0.1;  // a contact normal this far up pushes against gravity
+  std::unordered_set<const btCollisionObject*> pushed;
+  std::vector<char> may_rest, held;
+  std::vector<std::vector<RestContact>> rest_contacts;
+  std::vector<Eigen::Vector2d> support;
+  ContactFinder rest_finder;
+  std::vector<PosedMesh> posed;
+  std::vector<ObjectPair> touching_candidates;
+  std::vector<FacePair> touching_faces;
+  std::vector<double> object_margins;  // per scene object: margin_outside of its shape
 
   int find(int i) {
     while (island[i] != i) i = island[i] = island[island[i]];
@@ -193,8 +279,10 @@ struct FIGNetDynamicsWorld::Impl {
     return state;
   }
 
-  int add_object(const TriangleMesh& mesh, std::span<const Pose> poses,
-                 const std::optional<Pose>& next_pose, const StaticProperties& properties) {
+  int add_object(const btCollisionObject& owner, const TriangleMesh& mesh,
+                 std::span<const Pose> poses, const std::optional<Pose>& next_pose,
+                 const StaticProperties& properties) {
+    scene_owners.push_back(&owner);
     scene.objects.emplace_back();
     SceneObject& object = scene.objects.back();
     object.mesh = &mesh;
@@ -217,6 +305,19 @@ struct FIGNetDynamicsWorld::Impl {
       return;
     }
     const StaticProperties properties{0.0, object.getFriction(), object.getRestitution()};
+    if (is_dynamic(&object)) {
+      // A body held by the rest guard: it does not move, and keeps the mesh the network knows.
+      auto found = scene_index.find(&object);
+      if (found == scene_index.end()) {
+        const BodyState& state = states.at(&object);
+        found = scene_index
+                    .emplace(&object, add_object(object, *state.mesh, state.poses,
+                                                 state.poses.back(), properties))
+                    .first;
+      }
+      candidates.push_back({partner, found->second});
+      return;
+    }
     const Pose pose = from_bt(object.getWorldTransform());
     const btCollisionShape* shape = object.getCollisionShape();
     if (shape->isConcave()) {
@@ -231,7 +332,7 @@ struct FIGNetDynamicsWorld::Impl {
       if (!piece) return;
       pieces.push_back(std::move(piece));
       const std::vector<Pose> poses(graph.history + 1, pose);
-      candidates.push_back({partner, add_object(*pieces.back(), poses, pose, properties)});
+      candidates.push_back({partner, add_object(object, *pieces.back(), poses, pose, properties)});
       return;
     }
     auto found = scene_index.find(&object);
@@ -250,7 +351,8 @@ struct FIGNetDynamicsWorld::Impl {
       }
       meshes.push_back(shapes.mesh_of(*shape));
       found =
-          scene_index.emplace(&object, add_object(*meshes.back(), poses, next, properties)).first;
+          scene_index.emplace(&object, add_object(object, *meshes.back(), poses, next, properties))
+              .first;
     }
     candidates.push_back({partner, found->second});
   }
@@ -285,6 +387,7 @@ struct FIGNetDynamicsWorld::Impl {
   // kinematic objects near them, and the object pairs to search for faces.
   void build_scene() {
     scene.objects.clear();
+    scene_owners.clear();
     scene.floor.reset();
     networked.clear();
     scene_index.clear();
@@ -295,21 +398,24 @@ struct FIGNetDynamicsWorld::Impl {
       if (!in_network[i]) continue;
       btRigidBody* body = moving[i];
       scene_index[body] =
-          add_object(*states[body].mesh, states[body].poses, std::nullopt,
+          add_object(*body, *states[body].mesh, states[body].poses, std::nullopt,
                      {1.0 / body->getInvMass(), body->getFriction(), body->getRestitution()});
       networked.push_back(static_cast<int>(i));
     }
     auto in_scene = [&](const btCollisionObject* object) {
       return is_moving(object) && in_network[moving_index.at(object)];
     };
+    auto is_held = [&](const btCollisionObject* object) {
+      return is_moving(object) && held[moving_index.at(object)];
+    };
     for (const auto& [a, b] : pairs) {
       const bool a_in = in_scene(a), b_in = in_scene(b);
       if (a_in && b_in) {
         candidates.push_back(
             {std::min(scene_index[a], scene_index[b]), std::max(scene_index[a], scene_index[b])});
-      } else if (a_in && !is_dynamic(b)) {
+      } else if (a_in && (!is_dynamic(b) || is_held(b))) {
         add_obstacle(*b, scene_index[a], *a);
-      } else if (b_in && !is_dynamic(a)) {
+      } else if (b_in && (!is_dynamic(a) || is_held(a))) {
         add_obstacle(*a, scene_index[b], *b);
       }
     }
@@ -344,7 +450,7 @@ struct FIGNetDynamicsWorld::Impl {
   // Which moving bodies the network predicts: all of them, or, with free flight, those with a
   // collision edge (a body without any broadphase pair has none for certain; the others are
   // searched as the graph builder will search them).
-  void choose_network_bodies() {
+  void choose_network_bodies(btCollisionWorld& world) {
     in_network.assign(moving.size(), options.free_flight ? 0 : 1);
     if (options.free_flight) {
       auto may_touch = [&](const btCollisionObject* body, const btCollisionObject* other) {
@@ -359,16 +465,21 @@ struct FIGNetDynamicsWorld::Impl {
         if (may_touch(b, a)) in_network[moving_index.at(b)] = 1;
       }
     }
+    held.assign(moving.size(), 0);
     build_scene();
-    if (!options.free_flight || networked.empty()) return;
-    contact_query->find_interacting_objects(scene, candidates, interacting);
-    bool all_interact = true;
-    for (size_t k = 0; k < networked.size(); ++k) {
-      if (interacting[k]) continue;
-      in_network[networked[k]] = 0;
-      all_interact = false;
+    if (options.free_flight && !networked.empty()) {
+      contact_query->find_interacting_objects(scene, candidates, interacting);
+      bool all_interact = true;
+      for (size_t k = 0; k < networked.size(); ++k) {
+        if (interacting[k]) continue;
+        in_network[networked[k]] = 0;
+        all_interact = false;
+      }
+      if (!all_interact) build_scene();
     }
-    if (!all_interact) build_scene();
+    // Bodies that stand at rest leave the network; to the bodies near them they are obstacles
+    // that do not move.
+    if (hold_resting_bodies(world)) build_scene();
   }
 
   // Free flight: x_{t+1} = 2x_t − x_{t−1} + g·dt², exact for constant acceleration (applied
@@ -396,7 +507,11 @@ struct FIGNetDynamicsWorld::Impl {
       for (size_t k = 0; k < networked.size(); ++k) next[networked[k]] = network_next[k];
     }
     for (size_t i = 0; i < moving.size(); ++i) {
-      if (!in_network[i]) next[i] = free_flight_pose(*moving[i]);
+      if (held[i]) {
+        next[i] = states.at(moving[i]).poses.back();
+      } else if (!in_network[i]) {
+        next[i] = free_flight_pose(*moving[i]);
+      }
     }
   }
 
@@ -518,6 +633,222 @@ struct FIGNetDynamicsWorld::Impl {
     }
   }
 
+  // The contacts of the networked bodies, from two sources that fail in different places:
+  //  - the meshes the network sees: the vertices of one object within reach of a face of the
+  //    other, both ways, with the other face's outward normal (against the floor, the body's
+  //    vertices within reach of it). Reach is rest_contact_distance plus the collision margins
+  //    Bullet adds around hulls and triangle meshes, which keep resting meshes that far apart.
+  //    It gives a flat face all its corners, where Bullet reports one point per pair of convex
+  //    hulls and none for boxes a rounding error apart;
+  //  - Bullet's narrow phase on the collision shapes (contactTest): a sphere's one point under
+  //    its centre, which a faceted sphere mesh has no vertex at.
+  void find_rest_contacts(btCollisionWorld& world) {
+    const size_t n = networked.size();
+    const double reach = options.rest_contact_distance;
+    for (size_t k = 0; k < n; ++k) {
+      std::vector<RestContact>& contacts = rest_contacts[networked[k]];
+      contacts.clear();
+      ContactsOf bullet_contacts(scene_owners[k], reach, contacts);
+      world.contactTest(const_cast<btCollisionObject*>(scene_owners[k]), bullet_contacts);
+    }
+    if (scene.floor) {
+      for (size_t k = 0; k < n; ++k) {
+        const auto vertices = scene.objects[k].positions_at(graph.history);
+        const btCollisionObject& body = *scene_owners[k];
+        const double friction =
+            std::clamp(double(body.getFriction()) * scene.floor->properties.friction, -10.0, 10.0);
+        const double floor_reach = reach + margin_outside(*body.getCollisionShape());
+        for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
+          if (vertices(v, 2) - scene.floor->height > floor_reach) continue;
+          rest_contacts[networked[k]].push_back(
+              {nullptr, vertices.row(v).transpose(), Vec3::UnitZ(), friction});
+        }
+      }
+    }
+    posed.clear();
+    object_margins.clear();
+    double widest = 0.0;
+    for (size_t k = 0; k < scene.objects.size(); ++k) {
+      const SceneObject& object = scene.objects[k];
+      posed.push_back({object.mesh, object.positions_at(graph.history).data(), object.kinematic});
+      object_margins.push_back(margin_outside(*scene_owners[k]->getCollisionShape()));
+      widest = std::max(widest, object_margins.back());
+    }
+    touching_candidates.clear();
+    for (const ObjectPair& pair : candidates) {
+      if (pair.b < int(scene.objects.size())) touching_candidates.push_back(pair);  // not the floor
+    }
+    rest_finder.update(posed, false);
+    rest_finder.find_face_pairs(touching_candidates, reach + 2 * widest, touching_faces);
+    auto triangle = [&](int object, int face) {
+      const auto vertices = scene.objects[object].positions_at(graph.history);
+      Triangle t;
+      for (int c = 0; c < 3; ++c)
+        t.v[c] = vertices.row(scene.objects[object].mesh->faces()(face, c)).transpose();
+      return t;
+    };
+    // Vertices of `from`'s face near `onto`'s face: contacts of the networked one of the two.
+    auto add_vertices = [&](int from, int face_from, int onto, int face_onto) {
+      const Triangle a = triangle(from, face_from), b = triangle(onto, face_onto);
+      Vec3 normal = (b.v[1] - b.v[0]).cross(b.v[2] - b.v[0]);
+      if (normal.norm() == 0) return;
+      normal.normalize();  // out of `onto`
+      const btCollisionObject* from_owner = scene_owners[from];
+      const btCollisionObject* onto_owner = scene_owners[onto];
+      const double friction = btManifoldResult::calculateCombinedFriction(from_owner, onto_owner);
+      const double pair_reach = reach + object_margins[from] + object_margins[onto];
+      for (const Vec3& vertex : a.v) {
+        if ((closest_point_on_triangle(vertex, b) - vertex).norm() > pair_reach) continue;
+        if (from < int(n))
+          rest_contacts[networked[from]].push_back({onto_owner, vertex, normal, friction});
+        if (onto < int(n))
+          rest_contacts[networked[onto]].push_back({from_owner, vertex, -normal, friction});
+      }
+    };
+    for (const FacePair& pair : touching_faces) {
+      add_vertices(pair.object_a, pair.face_a, pair.object_b, pair.face_b);
+      add_vertices(pair.object_b, pair.face_b, pair.object_a, pair.face_a);
+    }
+  }
+
+  // Every contact of one body on Bullet's collision shapes within a distance, seen from the body.
+  struct ContactsOf : btCollisionWorld::ContactResultCallback {
+    ContactsOf(const btCollisionObject* self, double distance, std::vector<RestContact>& out)
+        : self_(self), distance_(distance), out_(out) {
+      m_closestDistanceThreshold = btScalar(distance);  // touching, not only penetrating
+      m_collisionFilterGroup = self->getBroadphaseHandle()->m_collisionFilterGroup;
+      m_collisionFilterMask = self->getBroadphaseHandle()->m_collisionFilterMask;
+    }
+    bool needsCollision(btBroadphaseProxy* proxy) const override {
+      const auto* other = static_cast<const btCollisionObject*>(proxy->m_clientObject);
+      return ContactResultCallback::needsCollision(proxy) && other != self_ &&
+             other->hasContactResponse();
+    }
+    btScalar addSingleResult(btManifoldPoint& point, const btCollisionObjectWrapper* first, int,
+                             int, const btCollisionObjectWrapper* second, int, int) override {
+      if (point.getDistance() > distance_) return 0;
+      // m_normalWorldOnB points from the second object to the first.
+      const bool body_first = first->getCollisionObject() == self_;
+      const btCollisionObject* other =
+          body_first ? second->getCollisionObject() : first->getCollisionObject();
+      const Vec3 normal = from_bt(point.m_normalWorldOnB);
+      out_.push_back(
+          {as_floor(*other) ? nullptr : other,
+           from_bt(body_first ? point.getPositionWorldOnA() : point.getPositionWorldOnB()),
+           body_first ? normal : Vec3(-normal),
+           double(btManifoldResult::calculateCombinedFriction(self_, other))});
+      return 0;
+    }
+    const btCollisionObject* self_;
+    double distance_;
+    std::vector<RestContact>& out_;
+  };
+
+  // Whether moving body i is slower than the friction of what lies below it stops in one step:
+  // |v| and |ω|·radius <= μ·|g|·dt, μ the least combined friction of its contacts from below.
+  bool slow_enough(size_t i) const {
+    const BodyState& state = states.at(moving[i]);
+    const Vec3 up = -gravity.normalized();
+    double mu = INFINITY;
+    for (const RestContact& contact : rest_contacts[i]) {
+      if (contact.normal.dot(up) > kFromBelow) mu = std::min(mu, contact.friction);
+    }
+    if (!std::isfinite(mu)) return false;  // nothing below it
+    const Pose& pose = state.poses.back();
+    const Pose& previous = state.poses[state.poses.size() - 2];
+    const double speed = (pose.position - previous.position).norm() / time_step;
+    const double turn =
+        Eigen::AngleAxisd(pose.orientation * previous.orientation.conjugate()).angle();
+    const double limit = mu * gravity.norm() * time_step;
+    return speed <= limit && std::abs(turn) / time_step * state.radius <= limit;
+  }
+
+  // Whether slow body i stands (see FIGNetWorldOptions::rest_guard), given the bodies held so
+  // far. nullopt: it stands on a body whose own rest is not decided yet.
+  std::optional<bool> stands(size_t i) {
+    const BodyState& state = states.at(moving[i]);
+    const Vec3 up = -gravity.normalized();
+    const Vec3 e1 = up.unitOrthogonal(), e2 = up.cross(e1);
+    Vec3 normal_sum = Vec3::Zero();
+    double mu = INFINITY;
+    support.clear();
+    for (const RestContact& contact : rest_contacts[i]) {
+      const btCollisionObject* other = contact.other;
+      const bool below = contact.normal.dot(up) > kFromBelow;
+      if (other && is_moving(other)) {
+        const int j = moving_index.at(other);
+        if (!may_rest[j]) return false;  // something that moves touches it
+        if (!below) continue;            // a resting body beside or on top of it
+        if (!held[j]) return std::nullopt;
+      } else if (other && other->isKinematicObject()) {
+        return false;
+      }
+      if (!below) continue;  // a wall beside it
+      normal_sum += contact.normal;
+      mu = std::min(mu, contact.friction);
+      support.emplace_back(contact.point.dot(e1), contact.point.dot(e2));
+    }
+    if (support.empty()) return false;
+    // Gravity within the friction cone of the supports' mean normal.
+    const Vec3 normal = normal_sum.normalized();
+    if (up.cross(normal).norm() > mu * up.dot(normal)) return false;
+    // The centre of mass over the support.
+    const Vec3& centre = state.poses.back().position;
+    return within_hull(support, Eigen::Vector2d(centre.dot(e1), centre.dot(e2)),
+                       0.02 * state.radius);
+  }
+
+  // The rest guard (before write_back): bodies that stand at rest keep their pose, and their
+  // history becomes that pose, so the network next sees a body at rest. Bodies are decided from
+  // the ground up: a body on a slow body is decided once that body is.
+  bool hold_resting_bodies(btCollisionWorld& world) {
+    if (!options.rest_guard || networked.empty()) return false;
+    may_rest.assign(moving.size(), 0);
+    if (rest_contacts.size() < moving.size()) rest_contacts.resize(moving.size());
+    find_rest_contacts(world);
+    for (const int i : networked) {
+      // Pushed bodies move as the push says; bodies in free flight touch nothing.
+      may_rest[i] = !pushed.count(moving[i]) && slow_enough(i);
+    }
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (const int i : networked) {
+        if (!may_rest[i] || held[i]) continue;
+        const std::optional<bool> decided = stands(i);
+        if (!decided) continue;
+        if (*decided) {
+          held[i] = 1;
+        } else {
+          may_rest[i] = 0;  // the model moves it: what it touches cannot rest on it
+        }
+        changed = true;
+      }
+    }
+    // A body held before a body it touches was found to move is left to the model too, and so,
+    // in turn, is what stands on it.
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (const int i : networked) {
+        if (!held[i]) continue;
+        for (const RestContact& contact : rest_contacts[i]) {
+          if (!contact.other || !is_moving(contact.other)) continue;
+          if (may_rest[moving_index.at(contact.other)]) continue;
+          held[i] = may_rest[i] = 0;
+          changed = true;
+          break;
+        }
+      }
+    }
+    for (const int i : networked) {
+      if (!held[i]) continue;
+      BodyState& state = states[moving[i]];
+      std::fill(state.poses.begin(), state.poses.end(), Pose(state.poses.back()));
+      in_network[i] = 0;
+      ++stats.rested_bodies;
+    }
+    return stats.rested_bodies > 0;
+  }
+
   // New poses, velocities and interpolation state of the moving bodies.
   void write_back() {
     for (size_t i = 0; i < moving.size(); ++i) {
@@ -603,10 +934,13 @@ FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
   impl_->time_step = time_step;
   impl_->gravity = gravity;
   impl_->contact_query.emplace(graph);
-  if (options.penetration_tolerance < 0 || !std::isfinite(options.penetration_tolerance)) {
-    throw ConfigError(fmt::format(
-        "FIGNetDynamicsWorld: penetration_tolerance is {} m; it must be finite and >= 0",
-        options.penetration_tolerance));
+  for (const auto& [name, value] :
+       {std::pair("penetration_tolerance", options.penetration_tolerance),
+        std::pair("rest_contact_distance", options.rest_contact_distance)}) {
+    if (value < 0 || !std::isfinite(value)) {
+      throw ConfigError(
+          fmt::format("FIGNetDynamicsWorld: {} is {} m; it must be finite and >= 0", name, value));
+    }
   }
   const int budget = options.max_graph_vertices == FIGNetWorldOptions::kModelResolution
                          ? FIGNetWorldOptions::kDefaultGraphVertices
@@ -717,6 +1051,7 @@ void FIGNetDynamicsWorld::internalSingleStepSimulation(btScalar time_step) {
   if (m_internalPreTickCallback) (*m_internalPreTickCallback)(this, time_step);
   const auto start = Clock::now();
   impl.stats = {};
+  impl.pushed.clear();
   // Forces other than gravity (applyForce, applyTorque) become a velocity change over the step;
   // impulses already changed the velocity. Either reseeds the body's history.
   for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i) {
@@ -734,8 +1069,10 @@ void FIGNetDynamicsWorld::internalSingleStepSimulation(btScalar time_step) {
     const btVector3 extra = body->getTotalForce() - gravity / body->getInvMass();
     if (extra.length() > 1e-6 * gravity.length() / body->getInvMass() + 1e-12) {
       body->setLinearVelocity(body->getLinearVelocity() + extra * body->getInvMass() * time_step);
+      impl.pushed.insert(body);
     }
     if (body->getTotalTorque().length() > 0) {
+      impl.pushed.insert(body);
       body->setAngularVelocity(body->getAngularVelocity() + body->getInvInertiaTensorWorld() *
                                                                 body->getTotalTorque() * time_step);
     }
@@ -744,7 +1081,7 @@ void FIGNetDynamicsWorld::internalSingleStepSimulation(btScalar time_step) {
   computeOverlappingPairs();
   impl.collect_pairs_and_islands(*this);
   impl.collect_moving();
-  impl.choose_network_bodies();
+  impl.choose_network_bodies(*this);
   impl.stats.prepare_seconds = seconds_since(start);
 
   const auto predict_start = Clock::now();
@@ -760,7 +1097,8 @@ void FIGNetDynamicsWorld::internalSingleStepSimulation(btScalar time_step) {
   impl.stats.write_back_seconds = seconds_since(write_start);
   const int networked = static_cast<int>(impl.networked.size());
   impl.stats.simulated_bodies = networked;
-  impl.stats.free_flight_bodies = static_cast<int>(impl.moving.size()) - networked;
+  impl.stats.free_flight_bodies =
+      static_cast<int>(impl.moving.size()) - networked - impl.stats.rested_bodies;
   impl.stats.sleeping_bodies = static_cast<int>(impl.dynamic_bodies.size() - impl.moving.size());
   impl.stats.kinematic_objects = static_cast<int>(impl.scene.objects.size()) - networked;
   impl.stats.candidate_pairs = static_cast<int>(impl.candidates.size());

@@ -25,13 +25,14 @@ using bullet::SceneSpec;
 class PyScene {
  public:
   PyScene(std::shared_ptr<Model> model, bool free_flight, bool sleeping, bool penetration_guard,
-          bool sweep_guard, int threads, std::optional<int> graph_vertices)
+          bool sweep_guard, int threads, std::optional<int> graph_vertices, bool rest_guard)
       : model_(std::move(model)) {
     if (graph_vertices) options_.max_graph_vertices = *graph_vertices;
     options_.free_flight = free_flight;
     options_.sleeping = sleeping;
     options_.penetration_guard = penetration_guard;
     options_.sweep_guard = sweep_guard;
+    options_.rest_guard = rest_guard;
     options_.threads = threads;
     if (model_) {
       // Frames at the model's step, Bullet's 240 Hz substeps for the native reference.
@@ -116,7 +117,10 @@ class PyScene {
     out["mesh_nodes"] = s.mesh_nodes;
     out["guarded_bodies"] = s.guarded_bodies;
     out["recovered_bodies"] = s.recovered_bodies;
+    out["rested_bodies"] = s.rested_bodies;
+    out["prepare_seconds"] = s.prepare_seconds;
     out["predict_seconds"] = s.predict_seconds;
+    out["write_back_seconds"] = s.write_back_seconds;
     return out;
   }
 
@@ -207,15 +211,18 @@ void bind_scene(py::module_& m) {
 With a model, each frame is one learned step at the model's time step (1/48 s for MOVi-A):
 bodies with nothing within the collision radius fly exactly under gravity (free_flight), resting
 islands sleep as in Bullet (sleeping), and bodies that sink into the floor or other static bodies
-are pushed out (penetration_guard); turn all three off for the network alone, as `fignet eval`
-measures it. A mesh finer than the model was trained on enters the graph simplified to
+are pushed out (penetration_guard), and bodies that stand at rest stay where they are, by
+Coulomb's static friction under gravity (rest_guard); turn all four off for the network alone, as
+`fignet eval` measures it. A mesh finer than the model was trained on enters the graph simplified to
 `graph_vertices` (default None: the model's own resolution, 64 for MOVi-A; 0: never) within 2 %
 of its size; Bullet still collides the full mesh. Without a model, native Bullet steps at 240 Hz,
 5 substeps per frame.)")
-      .def(py::init<std::shared_ptr<Model>, bool, bool, bool, bool, int, std::optional<int>>(),
-           py::arg("model") = py::none(), py::arg("free_flight") = true, py::arg("sleeping") = true,
-           py::arg("penetration_guard") = true, py::arg("sweep_guard") = true,
-           py::arg("threads") = 1, py::arg("graph_vertices") = py::none())
+      .def(
+          py::init<std::shared_ptr<Model>, bool, bool, bool, bool, int, std::optional<int>, bool>(),
+          py::arg("model") = py::none(), py::arg("free_flight") = true, py::arg("sleeping") = true,
+          py::arg("penetration_guard") = true, py::arg("sweep_guard") = true,
+          py::arg("threads") = 1, py::arg("graph_vertices") = py::none(),
+          py::arg("rest_guard") = true)
       .def(
           "add_body",
           [](PyScene& scene, const py::handle& vertices, const py::handle& faces,

@@ -18,16 +18,9 @@
 namespace fignet::bullet {
 namespace {
 
+using testing::at;
 using testing::recording_predictor;
 using testing::WorldFixture;
-
-Pose at(const Vec3& position,
-        const Eigen::Quaterniond& orientation = Eigen::Quaterniond::Identity()) {
-  Pose pose;
-  pose.position = position;
-  pose.orientation = orientation;
-  return pose;
-}
 
 // Free flight, by the world's own path and by an exact-gravity predictor through the network's
 // path: both follow x_{n+1} = 2x_n − x_{n−1} + g·dt² from a constant-velocity history, so
@@ -288,10 +281,13 @@ TEST(FIGNetWorld, RestingBodiesSleepAndWakeWhenTouched) {
     Still() : RecordingPredictor(Vec3::Zero(), 1.0 / 48.0) {}
   };
   // With the world's defaults (free flight, guard) on a floor, so that the resting bodies are in
-  // contact and go through the predictor.
+  // contact and go through the predictor; without the rest guard, which would keep them out of
+  // it (tests/bullet/test_rest_guard.cpp).
   auto predictor = std::make_unique<Still>();
   auto* recorder = predictor.get();
-  WorldFixture fixture(std::move(predictor));
+  FIGNetWorldOptions no_rest_guard;
+  no_rest_guard.rest_guard = false;
+  WorldFixture fixture(std::move(predictor), {}, no_rest_guard);
   fixture.add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0, Pose{});
   btRigidBody* resting = fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0,
                                      at(Vec3(0, 0, 0.2)));
@@ -449,6 +445,7 @@ TEST(FIGNetWorld, ThePenetrationGuardHoldsAFallingModelOnStaticGeometry) {
       SCOPED_TRACE(surface + (guard ? " with the guard" : " without"));
       FIGNetWorldOptions options;
       options.penetration_guard = guard;
+      options.rest_guard = false;  // it would hold the sunken box where it stops
       options.allow_gravity_mismatch = true;
       WorldFixture fixture(std::make_unique<AlwaysFalls>(), {}, options);
       if (surface == "plane") {

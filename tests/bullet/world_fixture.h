@@ -10,6 +10,15 @@
 
 namespace fignet::testing {
 
+// A pose from a position and an orientation.
+inline Pose at(const Vec3& position,
+               const Eigen::Quaterniond& orientation = Eigen::Quaterniond::Identity()) {
+  Pose pose;
+  pose.position = position;
+  pose.orientation = orientation;
+  return pose;
+}
+
 // Records what the world asked for and answers with exact free fall.
 class RecordingPredictor : public GravityPredictor {
  public:

@@ -47,6 +47,20 @@ struct FIGNetWorldOptions {
   // does for its own solver. Depths are Bullet's contact distances (collision margins included).
   bool penetration_guard = true;
   double penetration_tolerance = 0.005;  // metres
+  // The rest guard, Coulomb's static friction under gravity. A body stays where it is when
+  //  - no force but gravity was applied to it this step and nothing that moves touches it;
+  //  - it is slower than friction stops in one step: |v| and |ω|·radius <= μ·|g|·dt, μ Bullet's
+  //    combined friction with what lies below it;
+  //  - it stands: its centre of mass over its support (the contact points within
+  //    rest_contact_distance, on the meshes the network sees, of static geometry and of bodies
+  //    held this step below it), and gravity within the friction cone of the support's mean
+  //    normal.
+  // So stacks at rest stay, and a body on a slope steeper than its friction, tipping over an
+  // edge, or touched by a moving body is left to the model. It replaces the network's small
+  // creep at rest, which integrates to metres over thousands of steps; Bullet's sleeping then
+  // takes over. false: the model moves resting bodies.
+  bool rest_guard = true;
+  double rest_contact_distance = 0.005;  // metres
   // The node budget: a body's mesh with more vertices than this is simplified (meshoptimizer,
   // once per shape) within simplify_tolerance of its largest side before it enters the graph, so
   // a 20,000-vertex mesh costs about what the model's own meshes cost; the tolerance keeps the
@@ -62,12 +76,13 @@ struct FIGNetWorldOptions {
   double simplify_tolerance = 0.02;
 
   // The network alone on every awake body, as `fignet eval` rolls out and the paper measures: no
-  // free flight, no sleeping, no penetration guard (the sweep guard is kept).
+  // free flight, no sleeping, no penetration or rest guard (the sweep guard is kept).
   static FIGNetWorldOptions network_alone() {
     FIGNetWorldOptions options;
     options.free_flight = false;
     options.sleeping = false;
     options.penetration_guard = false;
+    options.rest_guard = false;
     return options;
   }
   // Threads for the network's matrix products (see ModelPredictor; 0: every core). One keeps
@@ -80,12 +95,13 @@ struct FIGNetStepStats {
   int simulated_bodies = 0;       // awake dynamic bodies predicted by the model
   int free_flight_bodies = 0;     // awake dynamic bodies moved without it (no collision edge)
   int sleeping_bodies = 0;        // dynamic bodies skipped because Bullet put them to sleep
-  int kinematic_objects = 0;      // static and kinematic bodies in contact range, floor excluded
+  int kinematic_objects = 0;      // static, kinematic and held bodies in contact range, no floor
   int candidate_pairs = 0;        // broadphase pairs handed to the face-pair search
   int face_edges = 0;             // face–face edges of the graph
   int mesh_nodes = 0;             // mesh vertices in the network's graph (after the node budget)
   int guarded_bodies = 0;         // bodies stopped by the tunnelling guard
   int recovered_bodies = 0;       // bodies moved out of static geometry by the penetration guard
+  int rested_bodies = 0;          // awake bodies the rest guard kept still, without the network
   double prepare_seconds = 0;     // broadphase, islands, meshes and histories
   double predict_seconds = 0;     // graph and network
   double write_back_seconds = 0;  // rigid fits and Bullet state
