@@ -93,19 +93,21 @@ void adopt_physics(const std::vector<Trajectory>& data, ModelConfig& model) {
   }
 }
 
-// --set on a resumed run: the trainer's fields (loss, optimizer, sampling) may change, which
-// makes the continuation a new run from the checkpoint's weights and optimizer state; the model's
-// fields may not, since the parameters and normalisers were made for them.
+// --set on a resumed run: the trainer's fields (loss, optimizer, sampling) and the training noise
+// may change, which makes the continuation a new run from the checkpoint's weights and optimizer
+// state; the model's other fields may not, since the parameters and normalisers were made for
+// them.
 void apply_resume_settings(const std::vector<std::string>& settings, TrainingConfig& config,
                            bool root) {
   if (settings.empty()) return;
   TrainingConfig changed = config;
   for (const std::string& setting : settings) changed.apply_setting(setting);
   for (const std::string& name : config.differing_fields(changed)) {
-    if (TrainingConfig::is_model_field(name)) {
+    if (!TrainingConfig::changes_on_resume(name)) {
       throw ConfigError(fmt::format(
           "--set {}: a resumed run keeps its model's fields (the checkpoint has {} = {}); only "
-          "the trainer's fields (batch_size and after in --help's list) may change",
+          "the training noise and the trainer's fields (batch_size and after in --help's list) "
+          "may change",
           name, name, config.field_text(name)));
     }
     if (name == "steps") continue;  // --steps has the last word on the run's length
@@ -115,6 +117,8 @@ void apply_resume_settings(const std::vector<std::string>& settings, TrainingCon
     }
   }
   config.trainer = changed.trainer;
+  config.model.noise_std = changed.model.noise_std;
+  config.model.noise = changed.model.noise;
 }
 
 void run_train(const TrainArgs& args) {
@@ -321,11 +325,11 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "Model file written at every checkpoint and at the end")
       ->required();
   cmd->add_option("--checkpoint", args->checkpoint, "Checkpoint file (default: OUT.ckpt.h5)");
-  // A resumed run keeps its checkpoint's config unless --set changes a trainer field.
+  // A resumed run keeps its checkpoint's config unless --set changes a trainer field or the noise.
   cmd->add_flag("--resume", args->resume,
                 "Continue the run in the checkpoint file exactly where it stopped, with its "
-                "config; --steps and --set of the trainer's fields (batch_size onwards) may "
-                "change it")
+                "config; --steps and --set of the training noise (noise_std, noise) and the "
+                "trainer's fields (batch_size onwards) may change it")
       ->excludes(preset)
       ->excludes(config);
   cmd->add_option("--checkpoint-minutes", args->checkpoint_minutes, "Minutes between checkpoints")

@@ -178,6 +178,10 @@ bool TrainingConfig::is_model_field(std::string_view name) {
   return false;
 }
 
+bool TrainingConfig::changes_on_resume(std::string_view name) {
+  return !is_model_field(name) || name == "noise_std" || name == "noise";
+}
+
 std::vector<std::string> TrainingConfig::differing_fields(const TrainingConfig& other) const {
   std::vector<std::string> names;
   for (const auto& [key, field] : fields()) {
