@@ -168,6 +168,16 @@ struct FIGNetDynamicsWorld::Impl {
   std::vector<int> networked;     // moving bodies that are scene.objects[0 … n), in order
   std::vector<char> interacting;  // per scene object: has a collision edge
   std::vector<const btCollisionObject*> scene_owners;  // per scene object: whose it is
+  // The floor plane, and the groups of its partners that each get a floor mesh of their own.
+  struct FloorGroup {
+    Eigen::Vector2d seed, sum = Eigen::Vector2d::Zero();
+    int partners = 0;
+    bool far = false;  // a partner is far from the origin, where training had the floor
+    int index = -1;    // the floor's scene object
+  };
+  const btCollisionObject* floor_owner = nullptr;
+  TriangleMesh floor_patch;
+  std::vector<FloorGroup> floor_groups;
   std::unordered_map<const btCollisionObject*, int> scene_index;
   std::unordered_map<const btCollisionObject*, int> dynamic_index;  // into dynamic_bodies
   std::unordered_map<const btCollisionObject*, int> moving_index;   // into moving
@@ -297,7 +307,10 @@ struct FIGNetDynamicsWorld::Impl {
   void add_obstacle(btCollisionObject& object, int partner, const btCollisionObject& dynamic) {
     if (const std::optional<Floor> floor = as_floor(object);
         floor && graph.floor != FloorModel::kNone) {
-      if (!scene.floor) scene.floor = floor;
+      if (!scene.floor) {
+        scene.floor = floor;
+        floor_owner = &object;
+      }
       if (!near_floor(dynamic, *floor)) return;
       // A mesh floor is an object of the graph (its index is known once all objects are); an
       // implicit one is in every node's features.
@@ -383,6 +396,53 @@ struct FIGNetDynamicsWorld::Impl {
     return is_dynamic(object) && object->isActive();
   }
 
+  // The floor: the model's own floor mesh (±floor_half_extent), paired where the broadphase
+  // says. Training had it centred on the origin under every body; here it is centred under its
+  // partners when one is far from the origin, and partners farther apart than a quarter of the
+  // mesh's reach are grouped, each group under a floor patch of its own (a kinematic object of
+  // the same mesh and properties), so that no body is near a floor mesh's edge.
+  void place_floor() {
+    const double join = 0.25 * graph.floor_half_extent;
+    floor_groups.clear();
+    for (ObjectPair& pair : candidates) {
+      if (pair.b != -1) continue;
+      const Vec3 center = scene.objects[pair.a].centers.row(graph.history).transpose();
+      size_t g = 0;
+      while (g < floor_groups.size() && (floor_groups[g].seed - center.head<2>()).norm() > join) {
+        ++g;
+      }
+      if (g == floor_groups.size()) floor_groups.push_back({center.head<2>()});
+      FloorGroup& group = floor_groups[g];
+      group.sum += center.head<2>();
+      ++group.partners;
+      group.far =
+          group.far || center.head<2>().cwiseAbs().maxCoeff() > 0.5 * graph.floor_half_extent;
+      pair.b = -2 - static_cast<int>(g);
+    }
+    // Where a group's floor is centred: the origin as in training, or under the group.
+    auto center_of = [&](const FloorGroup& group) {
+      return group.far ? Eigen::Vector2d(group.sum / group.partners) : Eigen::Vector2d::Zero();
+    };
+    for (size_t g = 1; g < floor_groups.size(); ++g) {
+      const Eigen::Vector2d center = center_of(floor_groups[g]);
+      Pose pose;
+      pose.position = Vec3(center.x(), center.y(), scene.floor->height);
+      const std::vector<Pose> poses(graph.history + 1, pose);
+      floor_groups[g].index =
+          add_object(*floor_owner, floor_patch, poses, pose, scene.floor->properties);
+    }
+    // The scene's own floor (the first group's) comes after every object.
+    if (!floor_groups.empty()) {
+      const Eigen::Vector2d center = center_of(floor_groups[0]);
+      scene.floor->center_x = center.x();
+      scene.floor->center_y = center.y();
+      floor_groups[0].index = static_cast<int>(scene.objects.size());
+    }
+    for (ObjectPair& pair : candidates) {
+      if (pair.b <= -2) pair.b = floor_groups[static_cast<size_t>(-2 - pair.b)].index;
+    }
+  }
+
   // The scene the network sees: the moving bodies marked in `in_network`, the static and
   // kinematic objects near them, and the object pairs to search for faces.
   void build_scene() {
@@ -419,24 +479,7 @@ struct FIGNetDynamicsWorld::Impl {
         add_obstacle(*a, scene_index[b], *b);
       }
     }
-    // The floor: the model's own floor object, paired where the broadphase says, and centred
-    // under its partners when one is far from the origin (the mesh spans ±floor_half_extent).
-    const int floor_index = static_cast<int>(scene.objects.size());
-    Vec3 partners_sum = Vec3::Zero();
-    int partners = 0;
-    bool far = false;
-    for (ObjectPair& pair : candidates) {
-      if (pair.b != -1) continue;
-      pair.b = floor_index;
-      const Vec3 center = scene.objects[pair.a].centers.row(graph.history).transpose();
-      partners_sum += center;
-      ++partners;
-      far = far || center.head<2>().cwiseAbs().maxCoeff() > 0.5 * graph.floor_half_extent;
-    }
-    if (far) {
-      scene.floor->center_x = partners_sum.x() / partners;
-      scene.floor->center_y = partners_sum.y() / partners;
-    }
+    place_floor();
     std::sort(candidates.begin(), candidates.end(), [](const ObjectPair& x, const ObjectPair& y) {
       return std::tie(x.a, x.b) < std::tie(y.a, y.b);
     });
@@ -467,6 +510,9 @@ struct FIGNetDynamicsWorld::Impl {
     }
     held.assign(moving.size(), 0);
     build_scene();
+    // Bodies that stand at rest leave the network first (the cheaper test); to the bodies near
+    // them they are obstacles that do not move.
+    if (hold_resting_bodies(world)) build_scene();
     if (options.free_flight && !networked.empty()) {
       contact_query->find_interacting_objects(scene, candidates, interacting);
       bool all_interact = true;
@@ -477,9 +523,6 @@ struct FIGNetDynamicsWorld::Impl {
       }
       if (!all_interact) build_scene();
     }
-    // Bodies that stand at rest leave the network; to the bodies near them they are obstacles
-    // that do not move.
-    if (hold_resting_bodies(world)) build_scene();
   }
 
   // Free flight: x_{t+1} = 2x_t − x_{t−1} + g·dt², exact for constant acceleration (applied
@@ -676,7 +719,9 @@ struct FIGNetDynamicsWorld::Impl {
     }
     touching_candidates.clear();
     for (const ObjectPair& pair : candidates) {
-      if (pair.b < int(scene.objects.size())) touching_candidates.push_back(pair);  // not the floor
+      // The floor and its patches: the plane test above has them.
+      if (pair.b >= int(scene.objects.size()) || scene_owners[pair.b] == floor_owner) continue;
+      touching_candidates.push_back(pair);
     }
     rest_finder.update(posed, false);
     rest_finder.find_face_pairs(touching_candidates, reach + 2 * widest, touching_faces);
@@ -934,6 +979,7 @@ FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
   impl_->time_step = time_step;
   impl_->gravity = gravity;
   impl_->contact_query.emplace(graph);
+  impl_->floor_patch = make_floor_mesh(graph.floor_half_extent, graph.floor_segments);
   for (const auto& [name, value] :
        {std::pair("penetration_tolerance", options.penetration_tolerance),
         std::pair("rest_contact_distance", options.rest_contact_distance)}) {

@@ -580,6 +580,41 @@ TEST(FIGNetWorld, ABodyFarFromTheOriginStillMeetsTheFloor) {
   }
 }
 
+// Bodies on the floor farther apart than its mesh reaches (±40 m) each have floor under them: the
+// first group the scene's floor, the others a floor patch of the same mesh and properties.
+TEST(FIGNetWorld, BodiesFarApartEachHaveFloorUnderThem) {
+  auto predictor = testing::recording_predictor();
+  auto* recorder = predictor.get();
+  testing::WorldFixture fixture(std::move(predictor));
+  fixture.add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0, Pose{});
+  const std::vector<Vec3> places = {Vec3(2, 0, 0.25), Vec3(-3, 1, 0.25), Vec3(500, 80, 0.25),
+                                    Vec3(503, 80, 0.25)};
+  for (const Vec3& place : places) {
+    fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0, at(place));
+  }
+  fixture.step();
+  EXPECT_EQ(fixture.world.last_step_stats().simulated_bodies, 4);
+  const Scene& scene = recorder->last_scene;
+  ASSERT_EQ(scene.objects.size(), 5u);  // four bodies, one patch; the scene's floor is last
+  ASSERT_TRUE(scene.floor.has_value());
+  EXPECT_EQ(scene.floor->center_x, 0.0);  // as in training: the group near the origin
+  const SceneObject& patch = scene.objects[4];
+  EXPECT_TRUE(patch.kinematic);
+  const Vec3 patch_center = patch.centers.row(patch.num_steps() - 1).transpose();
+  EXPECT_NEAR((patch_center - Vec3(501.5, 80, 0)).norm(), 0.0, 1e-6);
+  const TriangleMesh floor = make_floor_mesh(40.0, 1);
+  EXPECT_EQ(patch.mesh->num_vertices(), floor.num_vertices());
+  EXPECT_EQ(patch.properties.friction, scene.floor->properties.friction);
+  // Each body pairs with the floor under it.
+  std::set<std::pair<int, int>> pairs;
+  for (const ObjectPair& pair : recorder->last_candidates) pairs.emplace(pair.a, pair.b);
+  const int scene_floor = 5;
+  for (const auto& [body, floor_index] :
+       std::vector<std::pair<int, int>>{{0, scene_floor}, {1, scene_floor}, {2, 4}, {3, 4}}) {
+    EXPECT_TRUE(pairs.count({body, floor_index})) << "body " << body;
+  }
+}
+
 }  // namespace
 }  // namespace fignet::bullet
 
