@@ -869,8 +869,10 @@ struct FIGNetDynamicsWorld::Impl {
         changed = true;
       }
     }
-    // A body held before a body it touches was found to move is left to the model too, and so,
-    // in turn, is what stands on it.
+    // Every body not held moves, undecided ones (resting on each other) included. A body held
+    // before a body it touches was found to move is left to the model too, and so, in turn, is
+    // what stands on it.
+    for (const int i : networked) may_rest[i] = held[i];
     for (bool changed = true; changed;) {
       changed = false;
       for (const int i : networked) {
