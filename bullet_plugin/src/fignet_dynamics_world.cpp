@@ -618,16 +618,26 @@ struct FIGNetDynamicsWorld::Impl {
   };
 
   // The deepest penetration of one body into static geometry, from Bullet's narrow phase.
-  struct StaticPenetration : btCollisionWorld::ContactResultCallback {
-    explicit StaticPenetration(const btCollisionObject* self) : self_(self) {
+  // Bullet's contacts of one body, through its own collision filter, with the other objects
+  // that respond to contact (static ones only, if asked).
+  struct BodyContacts : btCollisionWorld::ContactResultCallback {
+    BodyContacts(const btCollisionObject* self, bool static_only)
+        : self_(self), static_only_(static_only) {
       m_collisionFilterGroup = self->getBroadphaseHandle()->m_collisionFilterGroup;
       m_collisionFilterMask = self->getBroadphaseHandle()->m_collisionFilterMask;
     }
     bool needsCollision(btBroadphaseProxy* proxy) const override {
       const auto* other = static_cast<const btCollisionObject*>(proxy->m_clientObject);
       return ContactResultCallback::needsCollision(proxy) && other != self_ &&
-             other->isStaticObject() && other->hasContactResponse();
+             (!static_only_ || other->isStaticObject()) && other->hasContactResponse();
     }
+    const btCollisionObject* self_;
+    bool static_only_;
+  };
+
+  // The deepest penetration of one body into static geometry.
+  struct StaticPenetration : BodyContacts {
+    explicit StaticPenetration(const btCollisionObject* self) : BodyContacts(self, true) {}
     btScalar addSingleResult(btManifoldPoint& point, const btCollisionObjectWrapper* first, int,
                              int, const btCollisionObjectWrapper*, int, int) override {
       const double penetration = -point.getDistance();
@@ -639,7 +649,6 @@ struct FIGNetDynamicsWorld::Impl {
       depth = penetration;
       return 0;
     }
-    const btCollisionObject* self_;
     double depth = 0.0;
     Vec3 out = Vec3::Zero();
   };
@@ -694,20 +703,6 @@ struct FIGNetDynamicsWorld::Impl {
       ContactsOf bullet_contacts(scene_owners[k], reach, contacts);
       world.contactTest(const_cast<btCollisionObject*>(scene_owners[k]), bullet_contacts);
     }
-    if (scene.floor) {
-      for (size_t k = 0; k < n; ++k) {
-        const auto vertices = scene.objects[k].positions_at(graph.history);
-        const btCollisionObject& body = *scene_owners[k];
-        const double friction =
-            std::clamp(double(body.getFriction()) * scene.floor->properties.friction, -10.0, 10.0);
-        const double floor_reach = reach + margin_outside(*body.getCollisionShape());
-        for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
-          if (vertices(v, 2) - scene.floor->height > floor_reach) continue;
-          rest_contacts[networked[k]].push_back(
-              {nullptr, vertices.row(v).transpose(), Vec3::UnitZ(), friction});
-        }
-      }
-    }
     posed.clear();
     object_margins.clear();
     double widest = 0.0;
@@ -716,6 +711,18 @@ struct FIGNetDynamicsWorld::Impl {
       posed.push_back({object.mesh, object.positions_at(graph.history).data(), object.kinematic});
       object_margins.push_back(margin_outside(*scene_owners[k]->getCollisionShape()));
       widest = std::max(widest, object_margins.back());
+    }
+    if (scene.floor) {
+      for (size_t k = 0; k < n; ++k) {
+        const auto vertices = scene.objects[k].positions_at(graph.history);
+        const double friction =
+            btManifoldResult::calculateCombinedFriction(scene_owners[k], floor_owner);
+        for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
+          if (vertices(v, 2) - scene.floor->height > reach + object_margins[k]) continue;
+          rest_contacts[networked[k]].push_back(
+              {nullptr, vertices.row(v).transpose(), Vec3::UnitZ(), friction});
+        }
+      }
     }
     touching_candidates.clear();
     for (const ObjectPair& pair : candidates) {
@@ -757,17 +764,10 @@ struct FIGNetDynamicsWorld::Impl {
   }
 
   // Every contact of one body on Bullet's collision shapes within a distance, seen from the body.
-  struct ContactsOf : btCollisionWorld::ContactResultCallback {
+  struct ContactsOf : BodyContacts {
     ContactsOf(const btCollisionObject* self, double distance, std::vector<RestContact>& out)
-        : self_(self), distance_(distance), out_(out) {
+        : BodyContacts(self, false), distance_(distance), out_(out) {
       m_closestDistanceThreshold = btScalar(distance);  // touching, not only penetrating
-      m_collisionFilterGroup = self->getBroadphaseHandle()->m_collisionFilterGroup;
-      m_collisionFilterMask = self->getBroadphaseHandle()->m_collisionFilterMask;
-    }
-    bool needsCollision(btBroadphaseProxy* proxy) const override {
-      const auto* other = static_cast<const btCollisionObject*>(proxy->m_clientObject);
-      return ContactResultCallback::needsCollision(proxy) && other != self_ &&
-             other->hasContactResponse();
     }
     btScalar addSingleResult(btManifoldPoint& point, const btCollisionObjectWrapper* first, int,
                              int, const btCollisionObjectWrapper* second, int, int) override {
@@ -784,7 +784,6 @@ struct FIGNetDynamicsWorld::Impl {
            double(btManifoldResult::calculateCombinedFriction(self_, other))});
       return 0;
     }
-    const btCollisionObject* self_;
     double distance_;
     std::vector<RestContact>& out_;
   };
