@@ -97,6 +97,31 @@ TEST_P(Gemm, EmptyInnerDimensionGivesZerosOrLeavesTheSum) {
   gemm(RowMatrixXf(0, 5), Transpose::kNo, random_matrix(5, 3, 2), Transpose::kNo, empty, false);
 }
 
+// Weight gradients (aᵀ·b) sum over thousands of rows; threads share that sum, and the result must
+// be the same bits for any thread count (bit-exact resume on another machine's core count).
+TEST_P(Gemm, SumsOverRowsGiveTheSameBitsForAnyThreadCount) {
+  const EngineScope scope(GetParam());
+  const RowMatrixXf a = random_matrix(2500, 64, 1), b = random_matrix(2500, 48, 2);
+  const RowMatrixXf bt = b.transpose(), start = random_matrix(64, 48, 3);
+  auto run = [&](int threads, Transpose tb, bool accumulate) {
+    Eigen::setNbThreads(threads);
+    RowMatrixXf c = start;
+    gemm(a, Transpose::kYes, tb == Transpose::kNo ? b : bt, tb, c, accumulate);
+    Eigen::setNbThreads(0);
+    return c;
+  };
+  const MatrixXdRow exact = a.cast<double>().transpose() * b.cast<double>();
+  for (Transpose tb : {Transpose::kNo, Transpose::kYes}) {
+    for (bool accumulate : {false, true}) {
+      const RowMatrixXf one = run(1, tb, accumulate);
+      const MatrixXdRow expected = accumulate ? MatrixXdRow(exact + start.cast<double>()) : exact;
+      EXPECT_LT((one.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-5 * 2500);
+      EXPECT_EQ(run(2, tb, accumulate), one);
+      EXPECT_EQ(run(3, tb, accumulate), one);
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Engines, Gemm, ::testing::Values(GemmEngine::kEigen, GemmEngine::kOneDnn),
                          [](const auto& info) { return gemm_engine_name(info.param); });
 

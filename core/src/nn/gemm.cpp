@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
@@ -51,31 +52,131 @@ void eigen_gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b
   if (ta && tb) assign(a.transpose(), b.transpose());
 }
 
+// eigen_gemm on the calling thread alone: Eigen threads a product unless Eigen::nbThreads() is 1
+// or it runs inside an OpenMP team of several threads, so it gets such a team with one worker.
+void eigen_gemm_one_thread(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b,
+                           Transpose op_b, MatrixRef c, bool accumulate) {
+  if (Eigen::nbThreads() == 1 || omp_get_num_threads() > 1) {
+    eigen_gemm(a, op_a, b, op_b, c, accumulate);
+    return;
+  }
+#pragma omp parallel num_threads(2)
+#pragma omp single
+  eigen_gemm(a, op_a, b, op_b, c, accumulate);
+}
+
 #ifdef FIGNET_WITH_ONEDNN
-void onednn_gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b, Transpose op_b,
-                 MatrixRef c, bool accumulate) {
-  const Eigen::Index m = c.rows(), n = c.cols();
-  const Eigen::Index k = op_a == Transpose::kNo ? a.cols() : a.rows();
-  // oneDNN's OpenMP runtime takes omp_get_max_threads(); follow Eigen's setting, as Eigen would.
-  // Except for aᵀ·b (weight gradients: sums over the rows of a batch), which oneDNN may split
-  // along that sum between threads: one thread keeps the sum's order, and the gradients, the same
-  // for any thread count.
-  const int threads = op_a == Transpose::kYes ? 1 : Eigen::nbThreads();
+// Runs `body` with OpenMP's thread setting at `threads`, restored afterwards (oneDNN's OpenMP
+// runtime takes omp_get_max_threads()).
+template <typename Body>
+void with_omp_threads(int threads, Body&& body) {
   const int before = omp_get_max_threads();
   if (threads != before) omp_set_num_threads(threads);
-  // Row-major throughout: oneDNN's sgemm takes row-major operands and leading dimensions.
-  const dnnl_status_t status =
-      dnnl_sgemm(op_a == Transpose::kNo ? 'N' : 'T', op_b == Transpose::kNo ? 'N' : 'T', m, n, k,
-                 1.0f, a.data(), a.outerStride(), b.data(), b.outerStride(),
-                 accumulate ? 1.0f : 0.0f, c.data(), c.outerStride());
+  body();
   if (threads != before) omp_set_num_threads(before);
+}
+
+// oneDNN's sgemm on `threads` threads; returns its status.
+dnnl_status_t onednn_gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b,
+                          Transpose op_b, MatrixRef c, bool accumulate, int threads) {
+  const Eigen::Index m = c.rows(), n = c.cols();
+  const Eigen::Index k = op_a == Transpose::kNo ? a.cols() : a.rows();
+  dnnl_status_t status = dnnl_success;
+  with_omp_threads(threads, [&] {
+    // Row-major throughout: oneDNN's sgemm takes row-major operands and leading dimensions.
+    status = dnnl_sgemm(op_a == Transpose::kNo ? 'N' : 'T', op_b == Transpose::kNo ? 'N' : 'T', m,
+                        n, k, 1.0f, a.data(), a.outerStride(), b.data(), b.outerStride(),
+                        accumulate ? 1.0f : 0.0f, c.data(), c.outerStride());
+  });
+  return status;
+}
+
+void check_onednn(dnnl_status_t status, Eigen::Index m, Eigen::Index k, Eigen::Index n) {
   if (status != dnnl_success) {
     throw Error("gemm: oneDNN's sgemm failed (status " + std::to_string(status) + ") on " +
                 std::to_string(m) + "x" + std::to_string(k) + " times " + std::to_string(k) + "x" +
                 std::to_string(n));
   }
 }
+#endif
 
+// The engine's product on the calling thread alone; returns false where oneDNN failed.
+bool gemm_one_thread(GemmEngine engine, const ConstMatrixRef& a, Transpose op_a,
+                     const ConstMatrixRef& b, Transpose op_b, MatrixRef c, bool accumulate) {
+#ifdef FIGNET_WITH_ONEDNN
+  if (engine == GemmEngine::kOneDnn) {
+    return onednn_gemm(a, op_a, b, op_b, c, accumulate, 1) == dnnl_success;
+  }
+#endif
+  (void)engine;
+  eigen_gemm_one_thread(a, op_a, b, op_b, c, accumulate);
+  return true;
+}
+
+// Rows of a block of a weight gradient's sum (below): long enough that one product per block
+// runs the kernels at full speed, short enough that a scene's node and edge sets give two threads
+// several blocks each.
+constexpr Eigen::Index kSumBlockRows = 512;
+
+// c (+)= aᵀ·op_b(b): the weight gradients, sums over a batch's rows. Both engines would split
+// that sum between threads in a way that depends on their number, and so would the gradients'
+// last bits. Instead the rows are cut into blocks of kSumBlockRows; each block's product runs on
+// one thread into a partial of its own, and the partials are added to c in block order: the same
+// sums in the same order for any thread count, with the blocks shared among the threads.
+void weight_gradient(GemmEngine engine, const ConstMatrixRef& a, const ConstMatrixRef& b,
+                     Transpose op_b, MatrixRef c, bool accumulate) {
+  const Eigen::Index m = c.rows(), n = c.cols(), k = a.rows();
+  const Eigen::Index blocks = (k + kSumBlockRows - 1) / kSumBlockRows;
+  bool ok = true;
+  if (blocks == 1) {
+    ok = gemm_one_thread(engine, a, Transpose::kYes, b, op_b, c, accumulate);
+  } else {
+    // The partials persist per thread, so a steady-state step does not allocate.
+    thread_local AlignedFloats partials;
+    const size_t partial_size = static_cast<size_t>(m * n);
+    if (partials.size() < partial_size * blocks) partials.resize(partial_size * blocks);
+    float* const partial = partials.data();
+    std::atomic<bool> all_ok = true;
+    auto run_block = [&](Eigen::Index block) {
+      const Eigen::Index first = block * kSumBlockRows;
+      const Eigen::Index rows = std::min(kSumBlockRows, k - first);
+      MatrixView out(partial + block * partial_size, m, n);
+      const ConstMatrixRef b_block = op_b == Transpose::kNo
+                                         ? ConstMatrixRef(b.middleRows(first, rows))
+                                         : ConstMatrixRef(b.middleCols(first, rows));
+      if (!gemm_one_thread(engine, a.middleRows(first, rows), Transpose::kYes, b_block, op_b, out,
+                           false)) {
+        all_ok = false;
+      }
+    };
+    // No region of one thread: inside one, an enclosing team's threads would be hidden from
+    // gemm_one_thread's test.
+    const int team = omp_in_parallel() ? 1 : std::min<int>(Eigen::nbThreads(), blocks);
+    if (team > 1) {
+#pragma omp parallel for num_threads(team) schedule(static)
+      for (Eigen::Index block = 0; block < blocks; ++block) run_block(block);
+    } else {
+      for (Eigen::Index block = 0; block < blocks; ++block) run_block(block);
+    }
+    ok = all_ok;
+    // c = (c or 0) + partial_0 + partial_1 + ..., in that order for every element.
+    if (ok) {
+      for (Eigen::Index r = 0; r < m; ++r) {
+        float* row = c.row(r).data();
+        if (!accumulate) std::fill(row, row + n, 0.0f);
+        for (Eigen::Index block = 0; block < blocks; ++block) {
+          const float* in = partial + block * partial_size + r * n;
+          for (Eigen::Index j = 0; j < n; ++j) row[j] += in[j];
+        }
+      }
+    }
+  }
+#ifdef FIGNET_WITH_ONEDNN
+  if (!ok) check_onednn(dnnl_invalid_arguments, m, k, n);
+#endif
+}
+
+#ifdef FIGNET_WITH_ONEDNN
 const char* isa_name(dnnl_cpu_isa_t isa) {
   switch (isa) {
     case dnnl_cpu_isa_sse41:
@@ -113,9 +214,16 @@ void gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b, Tran
     if (!accumulate) c.setZero();
     return;
   }
+  const GemmEngine engine = current_engine().load(std::memory_order_relaxed);
+  if (op_a == Transpose::kYes) {
+    weight_gradient(engine, a, b, op_b, c, accumulate);
+    return;
+  }
 #ifdef FIGNET_WITH_ONEDNN
-  if (current_engine().load(std::memory_order_relaxed) == GemmEngine::kOneDnn) {
-    onednn_gemm(a, op_a, b, op_b, c, accumulate);
+  if (engine == GemmEngine::kOneDnn) {
+    // Threads as Eigen's setting says, as Eigen's products would.
+    check_onednn(onednn_gemm(a, op_a, b, op_b, c, accumulate, Eigen::nbThreads()), c.rows(), k,
+                 c.cols());
     return;
   }
 #endif

@@ -7,8 +7,9 @@
 //     preset); the fallback of a build without oneDNN.
 // Both use the threads Eigen::nbThreads() gives (Eigen::setNbThreads, OpenMP's default otherwise)
 // and run single-threaded inside an OpenMP parallel region. Results of one engine depend on the
-// shape and the processor, not on the thread count (oneDNN runs op_a = kYes products, the
-// sums over a batch's rows, on one thread for that).
+// shape and the processor, not on the thread count (oneDNN's op_a = kYes products, the sums
+// over a batch's rows, are cut into fixed blocks of rows shared among the threads and added in
+// block order for that).
 #pragma once
 
 #include <string>
