@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -192,8 +193,11 @@ void run_train(const TrainArgs& args) {
   }
   if (root) fmt::print("network passes on: {}\n", trainer.backend().name());
   if (!args.resume && config.trainer.statistics_warmup > 0) {
-    if (root) fmt::print("statistics warm-up: {} batches\n", config.trainer.statistics_warmup);
+    if (root) fmt::print("statistics warm-up: {} batches", config.trainer.statistics_warmup);
+    std::fflush(stdout);
     trainer.warm_up_statistics(config.trainer.statistics_warmup);
+    if (root) fmt::print(" ({:.1f} s)\n", trainer.times().warmup);
+    std::fflush(stdout);
   }
   std::optional<TrainingLog> log;
   if (root) log.emplace(log_path, trainer.steps_done());

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "../temp_folder.h"
@@ -64,6 +65,68 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   EXPECT_EQ(resumed.parameters(), uninterrupted.parameters());
   EXPECT_EQ(resumed.optimizer().second_moment(), uninterrupted.optimizer().second_moment());
   EXPECT_EQ(resumed.normalizers().target.mean(), uninterrupted.normalizers().target.mean());
+}
+
+// The parameters' moving average: what model() gives, kept in the checkpoint beside the
+// parameters being optimised, resumed bit for bit, and started at a resume that turns it on.
+TEST_F(Checkpoints, TheParameterAverageIsTheModelAndResumes) {
+  const auto data = falling_cubes();
+  TrainerConfig trainer_config;
+  trainer_config.batch_size = 2;
+  trainer_config.weight_average = 0.75f;
+  Trainer uninterrupted(tiny_model(), trainer_config, data);
+  // The average after each step, computed here in double from the parameters.
+  std::vector<double> average(uninterrupted.parameters().begin(), uninterrupted.parameters().end());
+  uninterrupted.run(8, [&](const TrainStep&) {
+    const std::vector<float>& p = uninterrupted.parameters();
+    for (size_t i = 0; i < p.size(); ++i) average[i] = 0.75 * average[i] + 0.25 * p[i];
+    return true;
+  });
+  const std::vector<float> averaged = uninterrupted.model()->parameters();
+  EXPECT_EQ(uninterrupted.current_model()->parameters(), uninterrupted.parameters());
+  ASSERT_NE(averaged, uninterrupted.parameters());
+  double worst = 0.0;
+  for (size_t i = 0; i < averaged.size(); ++i) {
+    worst = std::max(worst, std::abs(averaged[i] - average[i]) / (1e-3 + std::abs(average[i])));
+  }
+  EXPECT_LT(worst, 1e-5);
+
+  Trainer first(tiny_model(), trainer_config, data);
+  first.run(3, nullptr);
+  save_checkpoint(first, dir_ / "run.ckpt.h5", 8);
+  const Checkpoint checkpoint = load_checkpoint(dir_ / "run.ckpt.h5");
+  EXPECT_EQ(checkpoint.trainer_config.weight_average, 0.75f);
+  // The checkpoint's model is the parameters a resume continues from, not their average.
+  EXPECT_EQ(checkpoint.model->parameters(), first.parameters());
+  EXPECT_EQ(checkpoint.state.averaged_parameters, first.model()->parameters());
+  Trainer resumed(checkpoint.model->config(), checkpoint.trainer_config, data,
+                  checkpoint.model.get());
+  resumed.restore(checkpoint.state);
+  resumed.run(5, nullptr);
+  EXPECT_EQ(resumed.parameters(), uninterrupted.parameters());
+  EXPECT_EQ(resumed.model()->parameters(), averaged);
+
+  // Turned on at a resume of a run without one: it starts at the resumed parameters.
+  TrainerConfig plain = trainer_config;
+  plain.weight_average = 0.0f;
+  Trainer without(tiny_model(), plain, data);
+  without.run(3, nullptr);
+  EXPECT_EQ(without.model()->parameters(), without.parameters());
+  save_checkpoint(without, dir_ / "plain.ckpt.h5");
+  const Checkpoint no_average = load_checkpoint(dir_ / "plain.ckpt.h5");
+  EXPECT_TRUE(no_average.state.averaged_parameters.empty());
+  Trainer turned_on(no_average.model->config(), trainer_config, data, no_average.model.get());
+  turned_on.restore(no_average.state);
+  EXPECT_EQ(turned_on.model()->parameters(), without.parameters());
+}
+
+TEST_F(Checkpoints, AParameterAverageOutsideItsRangeIsRefused) {
+  const auto data = falling_cubes();
+  for (float decay : {-0.1f, 1.0f, std::nanf("")}) {
+    TrainerConfig trainer_config;
+    trainer_config.weight_average = decay;
+    EXPECT_THROW(Trainer(tiny_model(), trainer_config, data), ConfigError) << decay;
+  }
 }
 
 TEST_F(Checkpoints, LoadAsModelFilesButModelFilesDoNotResume) {

@@ -23,11 +23,15 @@ void write_training(H5::Group group, const TrainerConfig& config, const TrainerS
   write_attribute(group, "huber_delta", double{config.huber_delta});
   write_attribute(group, "statistics_warmup", static_cast<long long>(config.statistics_warmup));
   write_attribute(group, "rest_loss_weight", double{config.rest_loss_weight});
+  write_attribute(group, "weight_average", double{config.weight_average});
   write_attribute(group, "step", static_cast<long long>(state.step));
   write_attribute(group, "rng", state.rng);
   const hsize_t n = state.first_moment.size();
   hdf5::write_floats(group, "adam_first_moment", state.first_moment.data(), {n});
   hdf5::write_floats(group, "adam_second_moment", state.second_moment.data(), {n});
+  if (!state.averaged_parameters.empty()) {
+    hdf5::write_floats(group, "averaged_parameters", state.averaged_parameters.data(), {n});
+  }
 }
 
 void read_training(const H5::Group& group, size_t parameters, const std::string& where,
@@ -47,10 +51,14 @@ void read_training(const H5::Group& group, size_t parameters, const std::string&
     config.statistics_warmup = static_cast<int>(read_integer(group, "statistics_warmup"));
   if (group.attrExists("rest_loss_weight"))
     config.rest_loss_weight = static_cast<float>(read_double(group, "rest_loss_weight"));
+  if (group.attrExists("weight_average"))
+    config.weight_average = static_cast<float>(read_double(group, "weight_average"));
   state.step = read_integer(group, "step");
   state.rng = read_string(group, "rng");
   for (auto [name, out] : {std::pair("adam_first_moment", &state.first_moment),
-                           std::pair("adam_second_moment", &state.second_moment)}) {
+                           std::pair("adam_second_moment", &state.second_moment),
+                           std::pair("averaged_parameters", &state.averaged_parameters)}) {
+    if (out == &state.averaged_parameters && !exists(group, name)) continue;  // a run without
     const H5::DataSet dataset = group.openDataSet(name);
     if (shape_of(dataset, where) != std::vector<hsize_t>{parameters}) {
       throw FileError(
@@ -65,7 +73,8 @@ void read_training(const H5::Group& group, size_t parameters, const std::string&
 
 void save_checkpoint(const Trainer& trainer, const std::filesystem::path& path,
                      std::int64_t planned_steps) {
-  const auto model = trainer.model();
+  // The parameters being optimised, which a resume continues from; the average is in the state.
+  const auto model = trainer.current_model();
   const TrainerState state = trainer.state();
   hdf5::write_atomically(path, kWhat, [&](H5::H5File& file) {
     write_model_contents(file, *model);

@@ -67,6 +67,12 @@ Trainer::Trainer(const ModelConfig& config, const TrainerConfig& trainer_config,
   }
   grads_.assign(params_.size(), 0.0f);
   adam_ = Adam(params_.size(), trainer_config.adam);
+  if (!(trainer_config.weight_average >= 0.0f && trainer_config.weight_average < 1.0f)) {
+    throw ConfigError(fmt::format("trainer: weight_average = {} (must be in [0, 1); 0: none)",
+                                  trainer_config.weight_average));
+  }
+  // The average starts at the starting parameters (restore() replaces it with a checkpoint's).
+  if (trainer_config.weight_average > 0.0f) averaged_params_ = params_;
 }
 
 int Trainer::local_batch_size(int batch) const {
@@ -166,11 +172,15 @@ void Trainer::clip_gradient() {
 }
 
 void Trainer::warm_up_statistics(int batches) {
+  const TrainerTimes before = times_;
   for (int i = 0; i < batches; ++i) {
     // Counters from -1 down: apart from every training step's draws.
     std::mt19937_64 noise(draw_batch(-1 - static_cast<std::int64_t>(i), batch_));
     prepare_batch(batch_, noise, /*accumulate=*/true);
   }
+  // Its batches are no step's: the per-step phases stay the steps' own.
+  times_.warmup += (times_.build - before.build) + (times_.statistics - before.statistics);
+  times_.build = before.build, times_.statistics = before.statistics;
 }
 
 void Trainer::set_backend(std::unique_ptr<NetworkBackend> backend) {
@@ -289,6 +299,7 @@ TrainStep Trainer::step_on(const std::vector<SampleRef>& samples, std::uint64_t 
   times_.network += seconds_since(start);
   start = std::chrono::steady_clock::now();
   adam_.update(params_, grads_);
+  update_average();
   backend_->parameters_changed();
   times_.optimizer += seconds_since(start);
   result.step = adam_.step();
@@ -308,8 +319,16 @@ double Trainer::evaluate_loss(const std::vector<SampleRef>& samples) {
   return loss_and_gradient(false, false);
 }
 
+void Trainer::update_average() {
+  if (averaged_params_.empty()) return;
+  const float decay = trainer_config_.weight_average, rate = 1.0f - decay;
+  float* average = averaged_params_.data();
+  const float* current = params_.data();
+  for (size_t i = 0; i < params_.size(); ++i) average[i] = decay * average[i] + rate * current[i];
+}
+
 TrainerState Trainer::state() const {
-  return {adam_.step(), adam_.first_moment(), adam_.second_moment(), ""};
+  return {adam_.step(), adam_.first_moment(), adam_.second_moment(), "", averaged_params_};
 }
 
 void Trainer::restore(const TrainerState& state) {
@@ -321,9 +340,21 @@ void Trainer::restore(const TrainerState& state) {
   adam_.first_moment() = state.first_moment;
   adam_.second_moment() = state.second_moment;
   adam_.set_step(state.step);
+  // A run that turns the average on at a resume starts it from the parameters it resumes.
+  if (averaged_params_.empty() || state.averaged_parameters.empty()) return;
+  if (state.averaged_parameters.size() != params_.size()) {
+    throw ConfigError(fmt::format("trainer: averaged parameters have {} entries, the model {}",
+                                  state.averaged_parameters.size(), params_.size()));
+  }
+  averaged_params_ = state.averaged_parameters;
 }
 
 std::shared_ptr<const Model> Trainer::model() const {
+  if (averaged_params_.empty()) return current_model();
+  return std::make_shared<const Model>(config_, averaged_params_, normalizers_);
+}
+
+std::shared_ptr<const Model> Trainer::current_model() const {
   return std::make_shared<const Model>(config_, params_, normalizers_);
 }
 

@@ -110,6 +110,8 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.huber_delta; })},
       {"rest_loss_weight",
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.rest_loss_weight; })},
+      {"weight_average",
+       plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.weight_average; })},
       {"statistics_warmup",
        plain<int>([](TrainingConfig & c) -> auto& { return c.trainer.statistics_warmup; })},
       {"data_seed",
@@ -270,6 +272,12 @@ void TrainingConfig::validate() const {
     throw ConfigError(
         fmt::format("rest_loss_weight = {} (must be >= 0; 1: resting bodies count like the others)",
                     trainer.rest_loss_weight));
+  }
+  if (!(trainer.weight_average >= 0.0f && trainer.weight_average < 1.0f)) {
+    throw ConfigError(fmt::format(
+        "weight_average = {} (must be in [0, 1): the decay of the parameters' moving average; "
+        "0: none, 0.999: ~1000 steps)",
+        trainer.weight_average));
   }
   if (trainer.statistics_warmup < 0 || trainer.statistics_warmup > 1'000'000) {
     throw ConfigError(fmt::format("statistics_warmup = {} (must be in 0..1000000 batches)",

@@ -39,6 +39,11 @@ struct TrainerConfig {
   // Their targets are ~1e-3σ, so a bias that integrates to metres over a long rest costs the
   // unweighted loss almost nothing.
   float rest_loss_weight = 1.0f;
+  // Decay of an exponential moving average of the parameters, updated after every step (0: none;
+  // 0.999 averages over ~1000 steps). When on, the average is the model the run produces
+  // (model(), validation, the --out file): it smooths the step-to-step noise that makes
+  // successive checkpoints of one run differ by as much as recipes do.
+  float weight_average = 0.0f;
 };
 
 // Everything besides the model that makes training continue exactly where it stopped: the
@@ -48,12 +53,15 @@ struct TrainerState {
   std::int64_t step = 0;
   std::vector<float> first_moment, second_moment;
   std::string rng;  // unused since sampling is counter-based; kept for older checkpoints
+  // The parameters' moving average (empty when the run keeps none).
+  std::vector<float> averaged_parameters;
 };
 
 // Wall-clock seconds spent in each phase of the steps so far (this process), to tell what bounds
 // training: building graphs on the CPU, input statistics, the network's passes, or Adam.
 struct TrainerTimes {
   double build = 0.0, statistics = 0.0, network = 0.0, optimizer = 0.0;
+  double warmup = 0.0;  // the statistics warm-up's batches, apart from the steps' phases
 };
 
 struct TrainStep {
@@ -95,8 +103,11 @@ class Trainer {
   const NetworkBackend& backend() const { return *backend_; }
   const Network& network() const { return network_; }
 
-  // An immutable snapshot of the current parameters and statistics.
+  // An immutable snapshot of the model this run produces: the parameters' moving average when
+  // weight_average > 0, the parameters otherwise; with the current statistics.
   std::shared_ptr<const Model> model() const;
+  // The same with the parameters being optimised (what a checkpoint holds to resume from).
+  std::shared_ptr<const Model> current_model() const;
   std::int64_t steps_done() const { return adam_.step(); }
   const std::vector<SampleRef>& samples() const { return samples_; }
 
@@ -127,6 +138,8 @@ class Trainer {
   bool weighs_rest() const { return trainer_config_.rest_loss_weight != 1.0f; }
   // Scales grads_ to trainer_config_.gradient_clip when longer.
   void clip_gradient();
+  // averaged_params_ ← d·averaged_params_ + (1 − d)·params_, d = weight_average.
+  void update_average();
   std::mt19937_64 step_generator(std::int64_t step) const;
   // Fills `batch` with this process's share of the batch of draw number `counter` (a step's
   // number; warm-up batches count from -1 down) and returns the batch's noise seed.
@@ -137,6 +150,7 @@ class Trainer {
   const std::vector<Trajectory>& data_;
   Network network_;
   std::vector<float> params_;
+  std::vector<float> averaged_params_;  // empty unless weight_average > 0
   AlignedFloats grads_;  // aligned: reductions into it then sum in an address-independent order
   Normalizers normalizers_;
   Adam adam_;
