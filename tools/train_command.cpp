@@ -151,12 +151,14 @@ void run_train(const TrainArgs& args) {
   TrainingConfig config = resolve_config(args);
   std::shared_ptr<const Model> initial;
   TrainerState state;
+  int resumed_batch_size = 0;  // the checkpoint's, before any --set
   if (args.resume) {
     Checkpoint checkpoint = load_checkpoint(checkpoint_path);
     const std::int64_t steps = config.steps;
     config.model = checkpoint.model->config();
     if (config.model.mesh_vertices == 0) config.model.mesh_vertices = most_mesh_vertices(data);
     config.trainer = checkpoint.trainer_config;
+    resumed_batch_size = config.trainer.batch_size;
     // The run's own length unless --steps says otherwise.
     config.steps = args.steps >= 0                ? steps
                    : checkpoint.planned_steps > 0 ? checkpoint.planned_steps
@@ -200,7 +202,8 @@ void run_train(const TrainArgs& args) {
     std::fflush(stdout);
   }
   std::optional<TrainingLog> log;
-  if (root) log.emplace(log_path, trainer.steps_done());
+  if (root)
+    log.emplace(log_path, trainer.steps_done(), resumed_batch_size, config.trainer.batch_size);
 
   stop_requested = 0;
   std::signal(SIGINT, request_stop);

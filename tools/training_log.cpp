@@ -11,15 +11,24 @@
 
 namespace fignet::cli {
 
-TrainingLog::TrainingLog(const std::filesystem::path& path, std::int64_t resume_step) {
+TrainingLog::TrainingLog(const std::filesystem::path& path, std::int64_t resume_step,
+                         int resumed_batch_size, int batch_size)
+    : batch_size_(batch_size), resume_step_(resume_step), resume_samples_(0) {
   std::vector<std::string> kept;
   if (resume_step > 0) {
     std::ifstream in(path);
+    std::int64_t last_step = 0, last_samples = 0;
     for (std::string line; std::getline(in, line);) {
       const auto record = nlohmann::json::parse(line, nullptr, /*allow_exceptions=*/false);
-      if (record.is_object() && record.value("step", std::int64_t{0}) <= resume_step)
-        kept.push_back(line);
+      if (!record.is_object()) continue;
+      const std::int64_t step = record.value("step", std::int64_t{0});
+      if (step > resume_step) continue;
+      kept.push_back(line);
+      if (record.contains("samples")) last_step = step, last_samples = record["samples"];
     }
+    // The samples at the resume: the last line that counted them, and the checkpoint's batch
+    // for the steps after it (all of them in logs from before the field).
+    resume_samples_ = last_samples + (resume_step - last_step) * resumed_batch_size;
   }
   out_.open(path, std::ios::trunc);
   if (!out_) throw FileError(fmt::format("--log '{}': cannot write", path.string()));
@@ -27,9 +36,14 @@ TrainingLog::TrainingLog(const std::filesystem::path& path, std::int64_t resume_
   out_.flush();
 }
 
+std::int64_t TrainingLog::samples_at(std::int64_t step) const {
+  return resume_samples_ + (step - resume_step_) * batch_size_;
+}
+
 void TrainingLog::write_step(std::int64_t step, double loss, float learning_rate,
                              double steps_per_second, double gradient_norm) {
   out_ << nlohmann::json{{"step", step},
+                         {"samples", samples_at(step)},
                          {"loss", loss},
                          {"learning_rate", learning_rate},
                          {"steps_per_second", steps_per_second},
@@ -41,6 +55,7 @@ void TrainingLog::write_step(std::int64_t step, double loss, float learning_rate
 void TrainingLog::write_validation(std::int64_t step, const Evaluation& e,
                                    const OneStepTotals& one_step) {
   nlohmann::json line{{"step", step},
+                      {"samples", samples_at(step)},
                       {"valid_translation_m", e.mean_translation},
                       {"valid_rotation_deg", e.mean_rotation},
                       {"valid_final_translation_m", e.final_translation},

@@ -14,8 +14,12 @@ namespace fignet::cli {
 class TrainingLog {
  public:
   // Opens `path` for appending, keeping only the lines of steps <= `resume_step` (a fresh run
-  // passes 0 and starts an empty log).
-  TrainingLog(const std::filesystem::path& path, std::int64_t resume_step);
+  // passes 0 and starts an empty log). Every line has "samples", the scenes trained on so far:
+  // steps from here on count `batch_size` each, those before as the kept lines say, and steps
+  // after the last line that counted them `resumed_batch_size` each (the checkpoint's; a resume
+  // may change the batch).
+  TrainingLog(const std::filesystem::path& path, std::int64_t resume_step, int resumed_batch_size,
+              int batch_size);
 
   void write_step(std::int64_t step, double loss, float learning_rate, double steps_per_second,
                   double gradient_norm);
@@ -24,7 +28,11 @@ class TrainingLog {
                         const OneStepTotals& one_step);
 
  private:
+  std::int64_t samples_at(std::int64_t step) const;
+
   std::ofstream out_;
+  int batch_size_;
+  std::int64_t resume_step_, resume_samples_;
 };
 
 }  // namespace fignet::cli
