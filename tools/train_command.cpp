@@ -312,9 +312,10 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--valid", args->valid, "Held-out trajectory file for validation rollouts")
       ->check(CLI::ExistingFile);
   auto* preset =
-      cmd->add_option("--preset", args->preset,
-                      "Model preset: paper (L=128, M=10) or small (L=64, M=5), both with the "
-                      "recipe of docs/training-study.md (batch 128, ...)")
+      cmd->add_option(
+             "--preset", args->preset,
+             "Model preset: paper (L=128, M=10) or small (L=64, M=5), both with the "
+             "recipe of docs/training-study.md (batch 8, ...; on a GPU --set batch_size=128)")
           ->check(CLI::IsMember(ModelConfig::preset_names()))
           ->capture_default_str();
   auto* config =

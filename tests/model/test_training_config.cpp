@@ -57,7 +57,7 @@ TEST(TrainingConfig, PresetsCarryTheRecipeAndTheDefaultsStayTheOldOne) {
                                         "gradient_clip", "huber_delta", "statistics_warmup"}))
         << name;
     EXPECT_EQ(preset.field_text("noise"), "\"rigid\"");
-    EXPECT_EQ(preset.trainer.batch_size, 128);
+    EXPECT_EQ(preset.trainer.batch_size, 8);
     EXPECT_EQ(old.trainer.batch_size, 4);
     EXPECT_EQ(old.model.noise, NoiseKind::kVertex);
   }

@@ -113,10 +113,11 @@ bool gemm_one_thread(GemmEngine engine, const ConstMatrixRef& a, Transpose op_a,
   return true;
 }
 
-// Rows of a block of a weight gradient's sum (below): long enough that one product per block
-// runs the kernels at full speed, short enough that a scene's node and edge sets give two threads
-// several blocks each.
-constexpr Eigen::Index kSumBlockRows = 512;
+// Rows of a block of a weight gradient's sum (below). 512 cost 2-4 % of a one-thread training
+// step in partials and short products and gained 3 % on two threads; 2048 measured the same as
+// one product per sum on both (bench_network, 2026-11-23): the threads share the sums of a batch's
+// chunk-sized graphs, not of one scene's.
+constexpr Eigen::Index kSumBlockRows = 2048;
 
 // c (+)= aᵀ·op_b(b): the weight gradients, sums over a batch's rows. Both engines would split
 // that sum between threads in a way that depends on their number, and so would the gradients'
