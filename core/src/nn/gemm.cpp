@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 
 #include "fignet/error.h"
 
@@ -100,17 +101,18 @@ void check_onednn(dnnl_status_t status, Eigen::Index m, Eigen::Index k, Eigen::I
 }
 #endif
 
-// The engine's product on the calling thread alone; returns false where oneDNN failed.
-bool gemm_one_thread(GemmEngine engine, const ConstMatrixRef& a, Transpose op_a,
+// The engine's product on the calling thread alone.
+void gemm_one_thread(GemmEngine engine, const ConstMatrixRef& a, Transpose op_a,
                      const ConstMatrixRef& b, Transpose op_b, MatrixRef c, bool accumulate) {
 #ifdef FIGNET_WITH_ONEDNN
   if (engine == GemmEngine::kOneDnn) {
-    return onednn_gemm(a, op_a, b, op_b, c, accumulate, 1) == dnnl_success;
+    check_onednn(onednn_gemm(a, op_a, b, op_b, c, accumulate, 1), c.rows(),
+                 op_a == Transpose::kNo ? a.cols() : a.rows(), c.cols());
+    return;
   }
 #endif
   (void)engine;
   eigen_gemm_one_thread(a, op_a, b, op_b, c, accumulate);
-  return true;
 }
 
 // Rows of a block of a weight gradient's sum (below). 512 cost 2-4 % of a one-thread training
@@ -128,53 +130,52 @@ void weight_gradient(GemmEngine engine, const ConstMatrixRef& a, const ConstMatr
                      Transpose op_b, MatrixRef c, bool accumulate) {
   const Eigen::Index m = c.rows(), n = c.cols(), k = a.rows();
   const Eigen::Index blocks = (k + kSumBlockRows - 1) / kSumBlockRows;
-  bool ok = true;
   if (blocks == 1) {
-    ok = gemm_one_thread(engine, a, Transpose::kYes, b, op_b, c, accumulate);
-  } else {
-    // The partials persist per thread, so a steady-state step does not allocate.
-    thread_local AlignedFloats partials;
-    const size_t partial_size = static_cast<size_t>(m * n);
-    if (partials.size() < partial_size * blocks) partials.resize(partial_size * blocks);
-    float* const partial = partials.data();
-    std::atomic<bool> all_ok = true;
-    auto run_block = [&](Eigen::Index block) {
-      const Eigen::Index first = block * kSumBlockRows;
-      const Eigen::Index rows = std::min(kSumBlockRows, k - first);
-      MatrixView out(partial + block * partial_size, m, n);
-      const ConstMatrixRef b_block = op_b == Transpose::kNo
-                                         ? ConstMatrixRef(b.middleRows(first, rows))
-                                         : ConstMatrixRef(b.middleCols(first, rows));
-      if (!gemm_one_thread(engine, a.middleRows(first, rows), Transpose::kYes, b_block, op_b, out,
-                           false)) {
-        all_ok = false;
-      }
-    };
-    // No region of one thread: inside one, an enclosing team's threads would be hidden from
-    // gemm_one_thread's test.
-    const int team = omp_in_parallel() ? 1 : std::min<int>(Eigen::nbThreads(), blocks);
-    if (team > 1) {
+    gemm_one_thread(engine, a, Transpose::kYes, b, op_b, c, accumulate);
+    return;
+  }
+  // The partials persist per thread, so a steady-state step does not allocate.
+  thread_local AlignedFloats partials;
+  const size_t partial_size = static_cast<size_t>(m * n);
+  if (partials.size() < partial_size * blocks) partials.resize(partial_size * blocks);
+  float* const partial = partials.data();
+  auto run_block = [&](Eigen::Index block) {
+    const Eigen::Index first = block * kSumBlockRows;
+    const Eigen::Index rows = std::min(kSumBlockRows, k - first);
+    MatrixView out(partial + block * partial_size, m, n);
+    const ConstMatrixRef b_block = op_b == Transpose::kNo
+                                       ? ConstMatrixRef(b.middleRows(first, rows))
+                                       : ConstMatrixRef(b.middleCols(first, rows));
+    gemm_one_thread(engine, a.middleRows(first, rows), Transpose::kYes, b_block, op_b, out, false);
+  };
+  // No region of one thread: inside one, an enclosing team's threads would be hidden from
+  // gemm_one_thread's test.
+  const int team = omp_in_parallel() ? 1 : std::min<int>(Eigen::nbThreads(), blocks);
+  if (team > 1) {
+    // An exception may not leave the region: the first is rethrown after it.
+    std::exception_ptr failure;
 #pragma omp parallel for num_threads(team) schedule(static)
-      for (Eigen::Index block = 0; block < blocks; ++block) run_block(block);
-    } else {
-      for (Eigen::Index block = 0; block < blocks; ++block) run_block(block);
-    }
-    ok = all_ok;
-    // c = (c or 0) + partial_0 + partial_1 + ..., in that order for every element.
-    if (ok) {
-      for (Eigen::Index r = 0; r < m; ++r) {
-        float* row = c.row(r).data();
-        if (!accumulate) std::fill(row, row + n, 0.0f);
-        for (Eigen::Index block = 0; block < blocks; ++block) {
-          const float* in = partial + block * partial_size + r * n;
-          for (Eigen::Index j = 0; j < n; ++j) row[j] += in[j];
-        }
+    for (Eigen::Index block = 0; block < blocks; ++block) {
+      try {
+        run_block(block);
+      } catch (...) {
+#pragma omp critical
+        if (!failure) failure = std::current_exception();
       }
+    }
+    if (failure) std::rethrow_exception(failure);
+  } else {
+    for (Eigen::Index block = 0; block < blocks; ++block) run_block(block);
+  }
+  // c = (c or 0) + partial_0 + partial_1 + ..., in that order for every element.
+  for (Eigen::Index r = 0; r < m; ++r) {
+    float* row = c.row(r).data();
+    if (!accumulate) std::fill(row, row + n, 0.0f);
+    for (Eigen::Index block = 0; block < blocks; ++block) {
+      const float* in = partial + block * partial_size + r * n;
+      for (Eigen::Index j = 0; j < n; ++j) row[j] += in[j];
     }
   }
-#ifdef FIGNET_WITH_ONEDNN
-  if (!ok) check_onednn(dnnl_invalid_arguments, m, k, n);
-#endif
 }
 
 #ifdef FIGNET_WITH_ONEDNN
