@@ -1,9 +1,8 @@
 #include "fignet/model/network_backend.h"
 
-#include <omp.h>
-
 #include <algorithm>
-#include <exception>
+
+#include "parallel/parallel_for.h"
 
 namespace fignet {
 
@@ -45,9 +44,9 @@ class CpuBackend final : public NetworkBackend {
     }
     // Inference needs a workspace per thread; a later backward() needs every chunk's.
     MatrixView output = output_.view(graph.num_mesh_nodes(), 3);
-    run_parallel(chunk_count(), [&](int c) {
+    run_parallel(chunk_count(), [&](int c, int thread) {
       const Graph& chunk = chunk_graphs_[c];
-      NetworkWorkspace& ws = workspace(keep_for_backward ? c : omp_get_thread_num());
+      NetworkWorkspace& ws = workspace(keep_for_backward ? c : thread);
       output.middleRows(chunk_first_node_[c], chunk.num_mesh_nodes()) =
           network_.forward(params, normalizers, chunk, ws, keep_for_backward);
     });
@@ -141,17 +140,7 @@ class CpuBackend final : public NetworkBackend {
   void run_parallel(int n, F&& f) {
     const int threads = std::max(1, std::min(Eigen::nbThreads(), n));
     workspace(std::max(n, threads) - 1);  // before the threads: resizing moves workspaces
-    std::exception_ptr failure;
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-    for (int i = 0; i < n; ++i) {
-      try {
-        f(i);
-      } catch (...) {
-#pragma omp critical
-        if (!failure) failure = std::current_exception();
-      }
-    }
-    if (failure) std::rethrow_exception(failure);
+    detail::parallel_for(n, threads, detail::Schedule::kOneAtATime, f);
   }
 
   const Network& network_;

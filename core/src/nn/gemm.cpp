@@ -6,9 +6,9 @@
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
-#include <exception>
 
 #include "fignet/error.h"
+#include "parallel/parallel_for.h"
 
 #ifdef FIGNET_WITH_ONEDNN
 #include <oneapi/dnnl/dnnl.h>
@@ -148,25 +148,9 @@ void weight_gradient(GemmEngine engine, const ConstMatrixRef& a, const ConstMatr
                                        : ConstMatrixRef(b.middleCols(first, rows));
     gemm_one_thread(engine, a.middleRows(first, rows), Transpose::kYes, b_block, op_b, out, false);
   };
-  // No region of one thread: inside one, an enclosing team's threads would be hidden from
-  // gemm_one_thread's test.
-  const int team = omp_in_parallel() ? 1 : std::min<int>(Eigen::nbThreads(), blocks);
-  if (team > 1) {
-    // An exception may not leave the region: the first is rethrown after it.
-    std::exception_ptr failure;
-#pragma omp parallel for num_threads(team) schedule(static)
-    for (Eigen::Index block = 0; block < blocks; ++block) {
-      try {
-        run_block(block);
-      } catch (...) {
-#pragma omp critical
-        if (!failure) failure = std::current_exception();
-      }
-    }
-    if (failure) std::rethrow_exception(failure);
-  } else {
-    for (Eigen::Index block = 0; block < blocks; ++block) run_block(block);
-  }
+  // Inside a team the blocks stay on this thread: its products are single-threaded already.
+  const int threads = omp_in_parallel() ? 1 : Eigen::nbThreads();
+  detail::parallel_for(static_cast<int>(blocks), threads, detail::Schedule::kContiguous, run_block);
   // c = (c or 0) + partial_0 + partial_1 + ..., in that order for every element.
   for (Eigen::Index r = 0; r < m; ++r) {
     float* row = c.row(r).data();

@@ -3,11 +3,12 @@
 #pragma once
 
 #include <algorithm>
-#include <exception>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "fignet/rollout/predictor.h"
+#include "parallel/parallel_for.h"
 
 namespace fignet::detail {
 
@@ -15,22 +16,13 @@ template <class Work>  // void(AccelerationPredictor&, int trajectory)
 void for_each_trajectory(
     const std::function<std::unique_ptr<AccelerationPredictor>()>& make_predictor, int n,
     int threads, Work&& work) {
-  std::exception_ptr failure;
-#pragma omp parallel num_threads(std::max(1, std::min(threads, n)))
-  {
-    std::unique_ptr<AccelerationPredictor> predictor;
-#pragma omp for schedule(dynamic, 1)
-    for (int i = 0; i < n; ++i) {
-      try {
-        if (!predictor) predictor = make_predictor();
-        work(*predictor, i);
-      } catch (...) {
-#pragma omp critical
-        if (!failure) failure = std::current_exception();
-      }
-    }
-  }
-  if (failure) std::rethrow_exception(failure);
+  const int team = std::max(1, std::min(threads, n));
+  std::vector<std::unique_ptr<AccelerationPredictor>> predictors(team);
+  parallel_for(n, team, Schedule::kOneAtATime, [&](int i, int thread) {
+    std::unique_ptr<AccelerationPredictor>& predictor = predictors[thread];
+    if (!predictor) predictor = make_predictor();
+    work(*predictor, i);
+  });
 }
 
 }  // namespace fignet::detail

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "fignet/error.h"
+#include "parallel/parallel_for.h"
 
 namespace fignet {
 
@@ -144,19 +145,11 @@ void Trainer::build_batch_graph(const std::vector<SampleRef>& batch, std::mt1993
   if (static_cast<int>(part_graphs_.size()) < parts) part_graphs_.resize(parts);
   const std::span<const Scene> all(scenes_);
   // The first part is built straight into the batch graph, the others beside it.
-  std::exception_ptr failure;
-#pragma omp parallel for num_threads(parts) schedule(static, 1)
-  for (int i = 0; i < parts; ++i) {
-    try {
-      const int begin = scenes * i / parts, end = scenes * (i + 1) / parts;
-      make_samples(begin, end);
-      builders_[i].build(all.subspan(begin, end - begin), i == 0 ? graph_ : part_graphs_[i]);
-    } catch (...) {
-#pragma omp critical
-      if (!failure) failure = std::current_exception();
-    }
-  }
-  if (failure) std::rethrow_exception(failure);
+  detail::parallel_for(parts, parts, detail::Schedule::kContiguous, [&](int i) {
+    const int begin = scenes * i / parts, end = scenes * (i + 1) / parts;
+    make_samples(begin, end);
+    builders_[i].build(all.subspan(begin, end - begin), i == 0 ? graph_ : part_graphs_[i]);
+  });
   for (int i = 1; i < parts; ++i) append_graph(part_graphs_[i], graph_);
 }
 
