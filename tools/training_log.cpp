@@ -5,35 +5,47 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <vector>
 
 #include "fignet/error.h"
+#include "text_file.h"
 
 namespace fignet::cli {
 
 TrainingLog::TrainingLog(const std::filesystem::path& path, std::int64_t resume_step,
                          int resumed_batch_size, int batch_size)
     : batch_size_(batch_size), resume_step_(resume_step), resume_samples_(0) {
-  std::vector<std::string> kept;
+  std::string kept;
   if (resume_step > 0) {
     std::ifstream in(path);
     std::int64_t last_step = 0, last_samples = 0;
+    int line_number = 0;
     for (std::string line; std::getline(in, line);) {
+      ++line_number;
+      // A line cut short by a killed run is not JSON: it is dropped with the lines after the
+      // checkpoint.
       const auto record = nlohmann::json::parse(line, nullptr, /*allow_exceptions=*/false);
       if (!record.is_object()) continue;
-      const std::int64_t step = record.value("step", std::int64_t{0});
+      auto whole_number = [&](const char* field) -> std::int64_t {
+        if (!record.contains(field)) return 0;
+        if (!record[field].is_number_integer()) {
+          throw FileError(fmt::format("--log '{}', line {}: \"{}\" is {}, not a whole number",
+                                      path.string(), line_number, field, record[field].dump()));
+        }
+        return record[field].get<std::int64_t>();
+      };
+      const std::int64_t step = whole_number("step");
       if (step > resume_step) continue;
-      kept.push_back(line);
-      if (record.contains("samples")) last_step = step, last_samples = record["samples"];
+      kept += line + '\n';
+      if (record.contains("samples")) last_step = step, last_samples = whole_number("samples");
     }
     // The samples at the resume: the last line that counted them, and the checkpoint's batch
     // for the steps after it (all of them in logs from before the field).
     resume_samples_ = last_samples + (resume_step - last_step) * resumed_batch_size;
   }
-  out_.open(path, std::ios::trunc);
+  // The kept lines replace the log at once (a failure leaves the old one), then lines append.
+  write_text_atomically(path, kept);
+  out_.open(path, std::ios::app);
   if (!out_) throw FileError(fmt::format("--log '{}': cannot write", path.string()));
-  for (const std::string& line : kept) out_ << line << '\n';
-  out_.flush();
 }
 
 std::int64_t TrainingLog::samples_at(std::int64_t step) const {
