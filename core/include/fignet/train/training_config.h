@@ -21,8 +21,9 @@ struct TrainingConfig {
   bool decay_steps_given = false;
 
   // The model preset ("paper" or "small") trained with the recipe of docs/training-study.md:
-  // batch 8, rigid-body noise, log mass, no edges inside static bodies, normalisers frozen
-  // after 800 warm-up batches, gradients clipped to norm 1, Huber loss beyond 3σ.
+  // batch 8, the parameters' moving average (0.999) as the model, rigid-body noise, log mass, no
+  // edges inside static bodies, normalisers frozen after 800 warm-up batches, gradients clipped
+  // to norm 1, Huber loss beyond 3σ.
   // A default-constructed TrainingConfig keeps the first recipe (batch 4, vertex noise, ...),
   // which is what checkpoint and model files without these fields were trained with.
   static TrainingConfig preset_named(std::string_view name);
