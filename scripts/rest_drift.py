@@ -9,6 +9,9 @@ motion (native Bullet creeps ~7 µm per frame there by itself).
 
     PYTHONPATH=build/release/python python3 scripts/rest_drift.py \\
         --model models/movi-a-small.h5 --data data/movi-a/eval-192.h5
+
+--trace prints the first body's displacement and velocity along the run instead (how it is lost:
+a drift that grows as t², or one that stops).
 """
 
 import argparse
@@ -30,19 +33,40 @@ def resting_bodies(trajectories, frames, tolerance):
     return found
 
 
-def drift(model, t, o, steps):
-    """Displacement after the first step and after `steps` steps, metres."""
+def alone_at_rest(model, t, o):
+    """A scene of the body alone at its recorded rest pose, stepped by the network alone."""
     scene = fignet.Scene(model, free_flight=False, sleeping=False, penetration_guard=False,
                          rest_guard=False)
     scene.add_floor(height=t.floor_height)
     scene.add_body(t.vertices(o), t.faces(o), mass=t.masses[o], friction=t.frictions[o],
                    restitution=t.restitutions[o], position=t.positions[-1, o],
                    orientation=t.quaternions[-1, o])
+    return scene
+
+
+def drift(model, t, o, steps):
+    """Displacement after the first step and after `steps` steps, metres."""
+    scene = alone_at_rest(model, t, o)
     start = scene.positions[0].copy()
     scene.step(1)
     first = np.linalg.norm(scene.positions[0] - start)
     scene.step(steps - 1)
     return first, np.linalg.norm(scene.positions[0] - start)
+
+
+def trace(model, t, o, steps):
+    """The body's displacement (mm) and velocity (m/s) along the run, at a few steps."""
+    scene = alone_at_rest(model, t, o)
+    start = scene.positions[0].copy()
+    previous = start
+    for step in range(1, steps + 1):
+        scene.step(1)
+        now = scene.positions[0].copy()
+        if step in (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000) or step == steps:
+            d, v = 1000 * (now - start), (now - previous) / t.time_step
+            print(f"| {step} | {d[0]:.2f}, {d[1]:.2f}, {d[2]:.2f} | {v[0]:.3f}, {v[1]:.3f}, "
+                  f"{v[2]:.3f} |")
+        previous = now
 
 
 def main():
@@ -51,12 +75,23 @@ def main():
     parser.add_argument("--data", type=pathlib.Path, required=True)
     parser.add_argument("--bodies", type=int, default=12, help="resting bodies to try (first ones)")
     parser.add_argument("--steps", type=int, default=100, help="steps per body")
+    parser.add_argument("--trace", action="store_true",
+                        help="print each model's path of the first body instead")
     args = parser.parse_args()
 
     bodies = resting_bodies(fignet.read_trajectories(args.data), frames=10, tolerance=1e-4)
     bodies = bodies[: args.bodies]
     if not bodies:
         raise SystemExit(f"{args.data}: no body rests over its last 10 frames")
+    if args.trace:
+        t, o = bodies[0]
+        for path in args.model:
+            print(f"\n{path.name}: body {o} of a trajectory of {args.data.name}, "
+                  f"{t.masses[o]:.1f} kg, friction {t.frictions[o]:.2f}\n")
+            print("| step | displacement x, y, z (mm) | velocity x, y, z (m/s) |")
+            print("|---|---|---|")
+            trace(fignet.load_model(path), t, o, args.steps)
+        return
     print(f"{len(bodies)} bodies at rest in {args.data}, each alone, {args.steps} steps\n")
     print(f"| model | first step: median / max (mm) | after {args.steps} steps: median / max (m) |")
     print("|---|---|---|")

@@ -120,6 +120,7 @@ void apply_resume_settings(const std::vector<std::string>& settings, TrainingCon
   config.trainer = changed.trainer;
   config.model.noise_std = changed.model.noise_std;
   config.model.noise = changed.model.noise;
+  config.model.noise_correction = changed.model.noise_correction;
 }
 
 void run_train(const TrainArgs& args) {
@@ -321,7 +322,7 @@ void add_train_command(CLI::App& app) {
   auto* config =
       cmd->add_option("--config", args->config_file, "JSON file of config fields (see --set)")
           ->check(CLI::ExistingFile);
-  auto* settings = cmd->add_option(
+  cmd->add_option(
       "--set", args->settings, "Override one config field, key=value (repeatable). Fields: " + [] {
         std::string names;
         for (const auto& n : TrainingConfig::field_names())
@@ -336,8 +337,8 @@ void add_train_command(CLI::App& app) {
   // A resumed run keeps its checkpoint's config unless --set changes a trainer field or the noise.
   cmd->add_flag("--resume", args->resume,
                 "Continue the run in the checkpoint file exactly where it stopped, with its "
-                "config; --steps and --set of the training noise (noise_std, noise) and the "
-                "trainer's fields (batch_size onwards) may change it")
+                "config; --steps and --set of the training noise (noise_std, noise, "
+                "noise_correction) and the trainer's fields (batch_size onwards) may change it")
       ->excludes(preset)
       ->excludes(config);
   cmd->add_option("--checkpoint-minutes", args->checkpoint_minutes, "Minutes between checkpoints")

@@ -138,6 +138,33 @@ TEST_F(TwoTetrahedra, FaceFaceEdgeFromABottomToBsSideFace) {
               0,     0,     -1});                       // n_s: A's bottom, outward -z
 }
 
+// face_span_limit shortens each of the six spans (columns 4-27, [x, y, z, norm] each) longer than
+// the limit to that length, direction kept; d_rs, the normals and the node order stay.
+TEST_F(TwoTetrahedra, SpanLimitShortensOnlyTheLongSpans) {
+  GraphConfig config;
+  config.face_span_limit = 0.5;
+  Graph limited;
+  GraphBuilder(config).build(scene_, limited);
+  ASSERT_EQ(limited.face_edges.size(), graph_.face_edges.size());
+  EXPECT_EQ(limited.face_edges.senders, graph_.face_edges.senders);
+  EXPECT_EQ(limited.face_edges.receivers, graph_.face_edges.receivers);
+  int shortened = 0;
+  for (int e = 0; e < graph_.face_edges.size(); ++e) {
+    const float* whole = graph_.face_edges.features.row(e);
+    const float* row = limited.face_edges.features.row(e);
+    std::vector<double> expected(whole, whole + 34);
+    for (int block = 1; block <= 6; ++block) {
+      const double length = whole[4 * block + 3];
+      if (length <= 0.5) continue;
+      for (int c = 0; c < 4; ++c) expected[4 * block + c] *= 0.5 / length;
+      ++shortened;
+    }
+    expect_row(row, expected);
+  }
+  // Of the edge checked by hand above: one sender span (0.716) and two receiver spans (1, 1.41).
+  EXPECT_GE(shortened, 3);
+}
+
 TEST_F(TwoTetrahedra, ReverseEdgeSwapsRoles) {
   // Every face edge has a twin with senders and receivers exchanged and d_rs negated.
   for (int e = 0; e < graph_.face_edges.size(); e += 2) {

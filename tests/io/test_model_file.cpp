@@ -21,6 +21,8 @@ class ModelFile : public testing::TempFolderTest {
     config.latent_size = 16;
     config.message_passing_steps = 2;
     config.seed = 42;
+    config.noise_correction = 0.25;
+    config.graph.face_span_limit = 0.75;
     Model fresh(config);
     Normalizers normalizers = fresh.normalizers();
     RowMatrixXf rows = RowMatrixXf::Random(10, normalizers.mesh_node.size());
@@ -55,6 +57,8 @@ TEST_F(ModelFile, SaveThenLoadIsBitExact) {
   EXPECT_EQ(loaded.config().seed, 42u);
   EXPECT_EQ(loaded.config().graph.collision_radius, model_->config().graph.collision_radius);
   EXPECT_EQ(loaded.config().time_step, model_->config().time_step);
+  EXPECT_EQ(loaded.config().noise_correction, 0.25);
+  EXPECT_EQ(loaded.config().graph.face_span_limit, 0.75);
   EXPECT_EQ(loaded.normalizers().mesh_node.sum(), model_->normalizers().mesh_node.sum());
   EXPECT_EQ(loaded.normalizers().mesh_node.sum_squares(),
             model_->normalizers().mesh_node.sum_squares());

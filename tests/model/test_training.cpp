@@ -110,6 +110,37 @@ std::vector<Trajectory> flying_and_resting_cubes(int frames) {
   return data;
 }
 
+// The target's next position, x̃^t + (x̃^t − x̃^{t−1}) + target, is the clean next frame plus the
+// share 1 − c of the current position's noise: c = 0 undoes the velocity noise only, c = 1 the
+// position noise too. Checked against the clean scene for both kinds of noise.
+TEST(TrainingBatch, TargetUndoesTheVelocityNoiseAndTheChosenShareOfThePositionNoise) {
+  const auto data = spinning_cubes(8);
+  const int history = ModelConfig::preset_named("small").graph.history, frame = 4;
+  Scene clean;
+  scene_at_frame(data[0], frame, history, clean);
+  for (NoiseKind kind : {NoiseKind::kVertex, NoiseKind::kRigid}) {
+    for (double correction : {0.0, 0.5, 1.0}) {
+      std::mt19937_64 rng(7);
+      Scene noisy;
+      Points targets;
+      make_noisy_sample(data[0], frame, history, 1e-2, kind, correction, rng, noisy, targets);
+      Eigen::Index row = 0;
+      for (size_t o = 0; o < noisy.objects.size(); ++o) {
+        const SceneObject& object = noisy.objects[o];
+        const Eigen::Index v = object.mesh->num_vertices();
+        const Points noise = object.positions_at(history) - clean.objects[o].positions_at(history);
+        ASSERT_GT(noise.norm(), 1e-3);  // the noise is there to be undone
+        const Points next = 2.0 * object.positions_at(history) - object.positions_at(history - 1) +
+                            targets.middleRows(row, v);
+        const Points clean_next = posed_vertices(*object.mesh, data[0].objects[o].poses[frame + 1]);
+        EXPECT_LT((next - (clean_next + (1.0 - correction) * noise)).cwiseAbs().maxCoeff(), 1e-12)
+            << "object " << o << ", correction " << correction;
+        row += v;
+      }
+    }
+  }
+}
+
 TEST(TrainingBatch, FlagsBodiesThatStayStillAroundTheFrame) {
   auto data = flying_and_resting_cubes(6);
   const double still = kRestSpeed * data[0].time_step;

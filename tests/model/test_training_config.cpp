@@ -82,6 +82,10 @@ TEST(TrainingConfig, BadInputNamesTheField) {
             std::string::npos);
   config.trainer.batch_size = 0;
   EXPECT_NE(error_of([&] { config.validate(); }).find("batch_size = 0"), std::string::npos);
+  config.trainer.batch_size = 4;
+  config.apply_setting("noise_correction=1.5");
+  EXPECT_NE(error_of([&] { config.validate(); }).find("noise_correction = 1.5 (must be in [0, 1])"),
+            std::string::npos);
 }
 
 // fignet train lets decay_steps follow --steps unless a --set or --config named it.

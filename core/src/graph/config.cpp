@@ -22,6 +22,9 @@ void GraphConfig::validate() const {
   if (floor_segments < 1 || floor_segments > 1024) {
     fail("floor_segments", floor_segments, "must be in 1..1024");
   }
+  if (!(face_span_limit >= 0.0) || !std::isfinite(face_span_limit)) {
+    fail("face_span_limit", face_span_limit, "must be >= 0 metres (0: no limit)");
+  }
   if (!mesh_edges && !object_nodes) {
     fail("mesh_edges", "false", "needs object_nodes: without both, nothing couples a body's nodes");
   }

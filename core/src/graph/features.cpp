@@ -120,7 +120,7 @@ struct SortedFace {
   std::array<Vec3, 3> spans;  // x_j − p
 };
 
-SortedFace sort_face(const PosedMesh& posed, int face, const Vec3& point) {
+SortedFace sort_face(const PosedMesh& posed, int face, const Vec3& point, double span_limit) {
   SortedFace sorted;
   const auto vertices = posed.vertices();
   std::array<std::pair<std::tuple<double, double, double, double>, int>, 3> keyed;
@@ -133,6 +133,10 @@ SortedFace sort_face(const PosedMesh& posed, int face, const Vec3& point) {
   for (int k = 0; k < 3; ++k) {
     sorted.nodes[k] = keyed[k].second;
     sorted.spans[k] = vertices.row(keyed[k].second).transpose() - point;
+    // A floor triangle's spans (tens of metres) would set the features' scale and squash every
+    // object face's (decimetres); beyond the limit only their direction is kept.
+    const double length = sorted.spans[k].norm();
+    if (span_limit > 0.0 && length > span_limit) sorted.spans[k] *= span_limit / length;
   }
   return sorted;
 }
@@ -147,9 +151,9 @@ Vec3 current_normal(const PosedMesh& posed, int face) {
 // [d_rs, |d_rs|, (d_sj, |d_sj|)_j, (d_rj, |d_rj|)_j, n_r, n_s] (seed C.1.1).
 void put_face_edge(const PosedMesh& sender, int sender_face, const Vec3& p_s, int sender_first,
                    const PosedMesh& receiver, int receiver_face, const Vec3& p_r,
-                   int receiver_first, FaceEdgeSet& out) {
-  const SortedFace s = sort_face(sender, sender_face, p_s);
-  const SortedFace r = sort_face(receiver, receiver_face, p_r);
+                   int receiver_first, double span_limit, FaceEdgeSet& out) {
+  const SortedFace s = sort_face(sender, sender_face, p_s, span_limit);
+  const SortedFace r = sort_face(receiver, receiver_face, p_r, span_limit);
   float* row = put_vector(out.features.append_rows(1), p_r - p_s);
   for (const Vec3& span : s.spans) row = put_vector(row, span);
   for (const Vec3& span : r.spans) row = put_vector(row, span);
@@ -164,9 +168,11 @@ void put_face_edge(const PosedMesh& sender, int sender_face, const Vec3& p_s, in
 }  // namespace
 
 void append_face_edges(const FacePair& pair, const PosedMesh& a, const PosedMesh& b, int first_a,
-                       int first_b, FaceEdgeSet& out) {
-  put_face_edge(a, pair.face_a, pair.point_a, first_a, b, pair.face_b, pair.point_b, first_b, out);
-  put_face_edge(b, pair.face_b, pair.point_b, first_b, a, pair.face_a, pair.point_a, first_a, out);
+                       int first_b, double span_limit, FaceEdgeSet& out) {
+  put_face_edge(a, pair.face_a, pair.point_a, first_a, b, pair.face_b, pair.point_b, first_b,
+                span_limit, out);
+  put_face_edge(b, pair.face_b, pair.point_b, first_b, a, pair.face_a, pair.point_a, first_a,
+                span_limit, out);
 }
 
 void append_world_edges(const NodePair& pair, const PosedMesh& a, const PosedMesh& b, int first_a,

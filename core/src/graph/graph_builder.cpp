@@ -232,7 +232,7 @@ void GraphBuilder::build_scenes(std::span<const Scene> scenes,
       for (FacePair pair : scene_face_pairs_) {
         detail::append_face_edges(pair, posed_[pair.object_a], posed_[pair.object_b],
                                   first_node(pair.object_a), first_node(pair.object_b),
-                                  graph.face_edges);
+                                  config_.face_span_limit, graph.face_edges);
         pair.object_a += first_object;
         pair.object_b += first_object;
         face_pairs_.push_back(pair);

@@ -56,7 +56,9 @@ void write_config(H5::Group group, const ModelConfig& c) {
   write_attribute(group, "static_internal_edges",
                   static_cast<long long>(c.graph.static_internal_edges));
   write_attribute(group, "log_mass", static_cast<long long>(c.graph.log_mass));
+  write_attribute(group, "face_span_limit", c.graph.face_span_limit);
   write_attribute(group, "noise", std::string(c.noise == NoiseKind::kRigid ? "rigid" : "vertex"));
+  write_attribute(group, "noise_correction", c.noise_correction);
 }
 
 ModelConfig read_config(const H5::Group& group) {
@@ -100,12 +102,18 @@ ModelConfig read_config(const H5::Group& group) {
   c.graph.mesh_edges = flag("mesh_edges", true);
   c.graph.static_internal_edges = flag("static_internal_edges", true);
   c.graph.log_mass = flag("log_mass", false);
+  if (group.attrExists("face_span_limit")) {
+    c.graph.face_span_limit = read_double(group, "face_span_limit");
+  }
   if (group.attrExists("noise")) {
     const std::string noise = read_string(group, "noise");
     if (noise != "vertex" && noise != "rigid") {
       throw ConfigError(fmt::format("config/noise = '{}' (must be vertex or rigid)", noise));
     }
     c.noise = noise == "rigid" ? NoiseKind::kRigid : NoiseKind::kVertex;
+  }
+  if (group.attrExists("noise_correction")) {
+    c.noise_correction = read_double(group, "noise_correction");
   }
   c.validate();
   return c;

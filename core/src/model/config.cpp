@@ -38,6 +38,8 @@ void ModelConfig::validate() const {
   }
   if (!(noise_std >= 0.0) || !std::isfinite(noise_std))
     fail("noise_std", noise_std, "must be >= 0");
+  if (!(noise_correction >= 0.0 && noise_correction <= 1.0))
+    fail("noise_correction", noise_correction, "must be in [0, 1]");
   if (normalizer_max_accumulations < 1) {
     fail("normalizer_max_accumulations", normalizer_max_accumulations, "must be >= 1");
   }

@@ -125,7 +125,8 @@ void Trainer::build_batch_graph(const std::vector<SampleRef>& batch, std::mt1993
     for (int b = begin; b < end; ++b) {
       std::mt19937_64 rng(scene_seeds_[b]);
       make_noisy_sample(data_[batch[b].trajectory], batch[b].frame, h, config_.noise_std,
-                        config_.noise, rng, scenes_[b], scene_targets_[b]);
+                        config_.noise, config_.noise_correction, rng, scenes_[b],
+                        scene_targets_[b]);
       if (weighs_rest()) {
         const Trajectory& trajectory = data_[batch[b].trajectory];
         scene_resting_[b] =

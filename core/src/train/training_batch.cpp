@@ -14,7 +14,8 @@ std::vector<SampleRef> enumerate_samples(const std::vector<Trajectory>& data, in
 }
 
 void make_noisy_sample(const Trajectory& trajectory, int frame, int history, double noise_std,
-                       NoiseKind kind, std::mt19937_64& rng, Scene& scene, Points& targets) {
+                       NoiseKind kind, double position_correction, std::mt19937_64& rng,
+                       Scene& scene, Points& targets) {
   scene_at_frame(trajectory, frame, history, scene);
   Eigen::Index rows = 0;
   for (const SceneObject& object : scene.objects) rows += object.mesh->num_vertices();
@@ -62,11 +63,13 @@ void make_noisy_sample(const Trajectory& trajectory, int frame, int history, dou
         object.centers.row(k) += translation.transpose();
       }
     }
-    // Target from the clean next frame, corrected by the last position's noise.
+    // Target from the clean next frame: the velocity noise is undone, and the share
+    // `position_correction` of the last position's noise too (the rest is kept).
     const Points next_positions =
         posed_vertices(*object.mesh, trajectory.objects[o].poses[frame + 1]);
     targets.middleRows(row, v) = next_positions - 2.0 * object.positions_at(history) +
-                                 object.positions_at(history - 1) + noise;
+                                 object.positions_at(history - 1) +
+                                 (1.0 - position_correction) * noise;
     row += v;
   }
 }

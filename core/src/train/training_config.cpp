@@ -86,10 +86,14 @@ const std::vector<std::pair<std::string, Field>>& fields() {
          return c.model.graph.static_internal_edges;
        })},
       {"log_mass", plain<bool>([](TrainingConfig & c) -> auto& { return c.model.graph.log_mass; })},
+      {"face_span_limit",
+       plain<double>([](TrainingConfig & c) -> auto& { return c.model.graph.face_span_limit; })},
       {"noise_std", plain<double>([](TrainingConfig & c) -> auto& { return c.model.noise_std; })},
       {"noise",
        named_enum<NoiseKind>([](TrainingConfig & c) -> auto& { return c.model.noise; },
                              {{NoiseKind::kVertex, "vertex"}, {NoiseKind::kRigid, "rigid"}})},
+      {"noise_correction",
+       plain<double>([](TrainingConfig & c) -> auto& { return c.model.noise_correction; })},
       {"normalizer_max_accumulations", plain<std::int64_t>([](TrainingConfig & c) -> auto& {
          return c.model.normalizer_max_accumulations;
        })},
@@ -187,7 +191,8 @@ bool TrainingConfig::is_model_field(std::string_view name) {
 }
 
 bool TrainingConfig::changes_on_resume(std::string_view name) {
-  return !is_model_field(name) || name == "noise_std" || name == "noise";
+  return !is_model_field(name) || name == "noise_std" || name == "noise" ||
+         name == "noise_correction";
 }
 
 std::vector<std::string> TrainingConfig::differing_fields(const TrainingConfig& other) const {

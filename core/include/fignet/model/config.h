@@ -26,6 +26,10 @@ struct ModelConfig {
   int message_passing_steps = 10;  // M, unshared weights (seed C.1.2)
   double noise_std = 3e-4;         // random-walk noise at the last input position, metres
   NoiseKind noise = NoiseKind::kVertex;
+  // Share of the last input position's noise that the training target undoes: 0 the velocity
+  // noise only (GNS, the paper: a displaced body keeps its offset), 1 the position too (the model
+  // learns to pull a displaced or penetrating body back where the truth has it).
+  double noise_correction = 0.0;
   std::int64_t normalizer_max_accumulations = 1'000'000;  // statistics freeze afterwards
   double time_step = 1.0 / 48.0;   // seconds between the frames the model was trained on
   Vec3 gravity = Vec3(0, 0, -10);  // the training data's gravity

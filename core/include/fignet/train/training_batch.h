@@ -21,12 +21,14 @@ std::vector<SampleRef> enumerate_samples(const std::vector<Trajectory>& data, in
 // Fills `scene` for the sample and adds random-walk noise to the positions of its dynamic nodes:
 // per-step velocity noise of std noise_std/sqrt(h), summed over the history, so the current
 // position's noise has std noise_std and the oldest none. Writes each node's target
-// x^{t+1} − 2x̃^t + x̃^{t−1} + n^t, which asks the model to undo the velocity noise (rows follow
-// scene.objects; kinematic rows are zero). NoiseKind::kRigid walks each body's pose instead:
-// translation steps of std noise_std/sqrt(h) and rotation steps of that over the body's radius,
-// applied to its vertices and centre together.
+// x^{t+1} − 2x̃^t + x̃^{t−1} + (1 − c)·n^t with c = position_correction: c = 0 asks the model to
+// undo the velocity noise only (GNS, the paper), c = 1 to return the node to its clean next
+// position, undoing the position noise too (rows follow scene.objects; kinematic rows are zero).
+// NoiseKind::kRigid walks each body's pose instead: translation steps of std noise_std/sqrt(h)
+// and rotation steps of that over the body's radius, applied to its vertices and centre together.
 void make_noisy_sample(const Trajectory& trajectory, int frame, int history, double noise_std,
-                       NoiseKind kind, std::mt19937_64& rng, Scene& scene, Points& targets);
+                       NoiseKind kind, double position_correction, std::mt19937_64& rng,
+                       Scene& scene, Points& targets);
 
 // Per object of the trajectory: 1 where the body is dynamic and at rest in the truth around the
 // sample, that is every vertex moves less than `max_step` metres over frame − 1 → frame and

@@ -42,8 +42,8 @@ struct TrainingConfig {
   // run's length.
   static bool is_model_field(std::string_view name);
   // Whether a resumed run may change the field (--set on --resume): the trainer's fields and the
-  // training noise (noise_std, noise), which shape the samples but not the parameters or the
-  // normalisers.
+  // training noise (noise_std, noise, noise_correction), which shape the samples but not the
+  // parameters or the normalisers.
   static bool changes_on_resume(std::string_view name);
   // The fields whose values differ from `other`'s, in documentation order.
   std::vector<std::string> differing_fields(const TrainingConfig& other) const;
