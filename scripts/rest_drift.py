@@ -11,7 +11,8 @@ motion (native Bullet creeps ~7 µm per frame there by itself).
         --model models/movi-a-small.h5 --data data/movi-a/eval-192.h5
 
 --trace prints the first body's displacement and velocity along the run instead (how it is lost:
-a drift that grows as t², or one that stops).
+a drift that grows as t², or one that stops); --slide the bodies' change of speed in one step when
+pushed along the floor, against Coulomb friction (how much friction the model learned).
 """
 
 import argparse
@@ -33,14 +34,18 @@ def resting_bodies(trajectories, frames, tolerance):
     return found
 
 
-def alone_at_rest(model, t, o):
-    """A scene of the body alone at its recorded rest pose, stepped by the network alone."""
+FLOOR_FRICTION = 0.3  # MOVi's floor (reference/facts.md); Bullet multiplies the two frictions
+
+
+def alone_at_rest(model, t, o, velocity=(0.0, 0.0, 0.0)):
+    """A scene of the body alone at its recorded rest pose (sliding at `velocity`, m/s), stepped
+    by the network alone."""
     scene = fignet.Scene(model, free_flight=False, sleeping=False, penetration_guard=False,
                          rest_guard=False)
-    scene.add_floor(height=t.floor_height)
+    scene.add_floor(height=t.floor_height, friction=FLOOR_FRICTION)
     scene.add_body(t.vertices(o), t.faces(o), mass=t.masses[o], friction=t.frictions[o],
                    restitution=t.restitutions[o], position=t.positions[-1, o],
-                   orientation=t.quaternions[-1, o])
+                   orientation=t.quaternions[-1, o], linear_velocity=velocity)
     return scene
 
 
@@ -69,6 +74,29 @@ def trace(model, t, o, steps):
         previous = now
 
 
+def slide(models, bodies, speeds):
+    """The change of speed in one step of each body pushed along x on the floor, mean over the
+    bodies, against Coulomb friction: −min(v, μ_body·μ_floor·g·dt)."""
+    print("| model | " + " | ".join(f"{v} m/s" for v in speeds) + " |")
+    print("|---|" + "---|" * len(speeds))
+    g_dt = 10.0 * bodies[0][0].time_step
+    coulomb = [np.mean([-min(v, t.frictions[o] * FLOOR_FRICTION * g_dt) for t, o in bodies])
+               for v in speeds]
+    print("| Coulomb friction | " + " | ".join(f"{c:+.3f}" for c in coulomb) + " |")
+    for path in models:
+        model = fignet.load_model(path)
+        changes = []
+        for v in speeds:
+            dv = []
+            for t, o in bodies:
+                scene = alone_at_rest(model, t, o, velocity=(v, 0.0, 0.0))
+                start = scene.positions[0].copy()
+                scene.step(1)
+                dv.append((scene.positions[0] - start)[0] / t.time_step - v)
+            changes.append(np.mean(dv))
+        print(f"| {path.name} | " + " | ".join(f"{c:+.3f}" for c in changes) + " |")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", type=pathlib.Path, action="append", required=True)
@@ -77,12 +105,19 @@ def main():
     parser.add_argument("--steps", type=int, default=100, help="steps per body")
     parser.add_argument("--trace", action="store_true",
                         help="print each model's path of the first body instead")
+    parser.add_argument("--slide", action="store_true",
+                        help="print the bodies' change of speed in one step when pushed instead")
     args = parser.parse_args()
 
     bodies = resting_bodies(fignet.read_trajectories(args.data), frames=10, tolerance=1e-4)
     bodies = bodies[: args.bodies]
     if not bodies:
         raise SystemExit(f"{args.data}: no body rests over its last 10 frames")
+    if args.slide:
+        print(f"{len(bodies)} bodies of {args.data.name} pushed along x on the floor: change of "
+              "speed in the first step (m/s), mean\n")
+        slide(args.model, bodies, [0.01, 0.03, 0.1, 0.3, 1.0, 3.0])
+        return
     if args.trace:
         t, o = bodies[0]
         for path in args.model:

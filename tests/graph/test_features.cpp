@@ -86,6 +86,29 @@ TEST_F(TwoTetrahedra, MeshNodeFeatures) {
              {0, 0, 0, 0, 0, 0, 0, 0, 0.0, 0.8, 0.7, 1, 0, 0, 0.001, 0.001});
 }
 
+// velocity_log_scale s adds sign(v)·ln(1 + |v|/s) of each velocity component after the velocities.
+TEST_F(TwoTetrahedra, VelocityLogarithmsFollowTheVelocities) {
+  GraphConfig config;
+  config.velocity_log_scale = 0.001;
+  Graph graph;
+  GraphBuilder(config).build(scene_, graph);
+  ASSERT_EQ(graph.mesh_nodes.cols(), 22);
+  ASSERT_EQ(graph.object_nodes.cols(), 22);
+  const double newest = std::log(21.0), oldest = std::log(11.0);  // 0.02 and 0.01 m over 0.001
+  for (int i = 0; i < 4; ++i) {
+    expect_row(graph.mesh_nodes.row(i), {0.02,   0, 0, 0.02, 0.01, 0,   0, 0.01, newest, 0, 0,
+                                         oldest, 0, 0, 2.0,  0.4,  0.3, 0, 0,    0,      0, 0});
+  }
+  expect_row(graph.object_nodes.row(1),
+             {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0.0, 0.8, 0.7, 1, 0, 0, 0.001, 0.001});
+  // A velocity along −x gives a negative logarithm.
+  Scene mirrored = scene_;
+  set_pose_history(mirrored.objects[0],
+                   std::vector<Pose>{{Vec3(0, 0, 0)}, {Vec3(-0.01, 0, 0)}, {Vec3(-0.03, 0, 0)}});
+  GraphBuilder(config).build(mirrored, graph);
+  EXPECT_NEAR(graph.object_nodes.row(0)[8], -newest, 1e-6);
+}
+
 TEST_F(TwoTetrahedra, MeshAndObjectEdgeFeatures) {
   // Edge 0 of the mesh is (0, 1): receiver minus sender is +x, now and at rest.
   EXPECT_EQ(graph_.mesh_edges.senders[0], 0);

@@ -22,6 +22,9 @@ void GraphConfig::validate() const {
   if (floor_segments < 1 || floor_segments > 1024) {
     fail("floor_segments", floor_segments, "must be in 1..1024");
   }
+  if (!(velocity_log_scale >= 0.0) || !std::isfinite(velocity_log_scale)) {
+    fail("velocity_log_scale", velocity_log_scale, "must be >= 0 metres per frame (0: off)");
+  }
   if (!(face_span_limit >= 0.0) || !std::isfinite(face_span_limit)) {
     fail("face_span_limit", face_span_limit, "must be >= 0 metres (0: no limit)");
   }
@@ -31,7 +34,8 @@ void GraphConfig::validate() const {
 }
 
 FeatureSizes feature_sizes(const GraphConfig& config) {
-  const int dynamic_part = 4 * config.history + 3 + 1 + 4;
+  const int log_velocities = config.velocity_log_scale > 0.0 ? 3 * config.history : 0;
+  const int dynamic_part = 4 * config.history + log_velocities + 3 + 1 + 4;
   return {
       .mesh_node = dynamic_part + (config.floor == FloorModel::kImplicit ? 2 : 0),
       .object_node = dynamic_part,

@@ -25,13 +25,23 @@ float* put_direction(float* out, const Vec3& n) {
   return out + 3;
 }
 
-// [x^t − x^{t−1}, …, x^{t−h+1} − x^{t−h}] (newest first), static properties, kinematic flag,
-// next-step displacement of kinematic nodes.
+// [x^t − x^{t−1}, …, x^{t−h+1} − x^{t−h}] (newest first), their signed logarithms when
+// configured, static properties, kinematic flag, next-step displacement of kinematic nodes.
 template <class PositionAt>
 float* put_dynamic_features(float* out, const GraphConfig& config, const SceneObject& object,
                             PositionAt position_at, const Vec3& next) {
   const int history = config.history;
   for (int k = history; k >= 1; --k) out = put_vector(out, position_at(k) - position_at(k - 1));
+  // The velocities above are normalised by a spread set by falls and impacts (~5 cm per frame),
+  // where a body sliding to a stop moves a fraction of a millimetre: sign(v)·ln(1 + |v|/s)
+  // resolves both.
+  if (const double s = config.velocity_log_scale; s > 0.0) {
+    for (int k = history; k >= 1; --k) {
+      const Vec3 v = position_at(k) - position_at(k - 1);
+      for (int c = 0; c < 3; ++c)
+        *out++ = static_cast<float>(std::copysign(std::log1p(std::abs(v[c]) / s), v[c]));
+    }
+  }
   // Kinematic bodies have mass 0: their log mass is taken as 0 too (the flag tells them apart).
   const double mass = object.properties.mass;
   *out++ = static_cast<float>(config.log_mass ? (mass > 0.0 ? std::log(mass) : 0.0) : mass);

@@ -57,6 +57,7 @@ void write_config(H5::Group group, const ModelConfig& c) {
                   static_cast<long long>(c.graph.static_internal_edges));
   write_attribute(group, "log_mass", static_cast<long long>(c.graph.log_mass));
   write_attribute(group, "face_span_limit", c.graph.face_span_limit);
+  write_attribute(group, "velocity_log_scale", c.graph.velocity_log_scale);
   write_attribute(group, "noise", std::string(c.noise == NoiseKind::kRigid ? "rigid" : "vertex"));
   write_attribute(group, "noise_correction", c.noise_correction);
 }
@@ -104,6 +105,9 @@ ModelConfig read_config(const H5::Group& group) {
   c.graph.log_mass = flag("log_mass", false);
   if (group.attrExists("face_span_limit")) {
     c.graph.face_span_limit = read_double(group, "face_span_limit");
+  }
+  if (group.attrExists("velocity_log_scale")) {
+    c.graph.velocity_log_scale = read_double(group, "velocity_log_scale");
   }
   if (group.attrExists("noise")) {
     const std::string noise = read_string(group, "noise");

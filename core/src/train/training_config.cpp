@@ -88,6 +88,8 @@ const std::vector<std::pair<std::string, Field>>& fields() {
       {"log_mass", plain<bool>([](TrainingConfig & c) -> auto& { return c.model.graph.log_mass; })},
       {"face_span_limit",
        plain<double>([](TrainingConfig & c) -> auto& { return c.model.graph.face_span_limit; })},
+      {"velocity_log_scale",
+       plain<double>([](TrainingConfig & c) -> auto& { return c.model.graph.velocity_log_scale; })},
       {"noise_std", plain<double>([](TrainingConfig & c) -> auto& { return c.model.noise_std; })},
       {"noise",
        named_enum<NoiseKind>([](TrainingConfig & c) -> auto& { return c.model.noise; },

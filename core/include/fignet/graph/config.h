@@ -36,6 +36,9 @@ struct GraphConfig {
   // many metres. The floor's 20–56 m spans otherwise set the features' scale, and objects' faces
   // (0.4 m median in MOVi-A) read as ~0.01σ; 0 keeps them whole (seed C.1.1).
   double face_span_limit = 0.0;
+  // > 0: node features also carry sign(v)·ln(1 + |v|/s) of each velocity component, s in metres
+  // per frame, so that sub-millimetre motion (a body sliding to a stop) is not ~0.01σ.
+  double velocity_log_scale = 0.0;
 
   // Throws ConfigError naming the first invalid field and its value.
   void validate() const;
@@ -43,7 +46,8 @@ struct GraphConfig {
 
 // Feature widths of each node and edge type under `config` (seed C.1.1 with C.2's norms).
 struct FeatureSizes {
-  int mesh_node;    // h·(3+1) velocities, 3 static properties, kinematic flag, 3+1 next-step move
+  int mesh_node;    // h·(3+1) velocities (+ h·3 logarithms), 3 static properties, kinematic
+                    // flag, 3+1 next-step move
   int object_node;  // as mesh nodes, at the centre of mass (no implicit-floor features)
   int mesh_edge;    // [d, |d|, d_rest, |d_rest|] = 8; also object->mesh and mesh->object
   int world_edge;   // [d, |d|] = 4 (node–node collision edges)
