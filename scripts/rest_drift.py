@@ -11,8 +11,9 @@ motion (native Bullet creeps ~7 µm per frame there by itself).
         --model models/movi-a-small.h5 --data data/movi-a/eval-192.h5
 
 --trace prints the first body's displacement and velocity along the run instead (how it is lost:
-a drift that grows as t², or one that stops); --slide the bodies' change of speed in one step when
-pushed along the floor, against Coulomb friction (how much friction the model learned).
+a drift that grows as t², or one that stops); --slide the friction the model applies in one step
+to a body pushed along the floor (the part of the change of speed that reverses with the push)
+against Coulomb's, and its bias (the change with no push).
 """
 
 import argparse
@@ -74,27 +75,40 @@ def trace(model, t, o, steps):
         previous = now
 
 
+def speed_change(model, t, o, velocity):
+    """The body's change of velocity (m/s) in one step from `velocity` (m/s)."""
+    scene = alone_at_rest(model, t, o, velocity=velocity)
+    start = scene.positions[0].copy()
+    scene.step(1)
+    return (scene.positions[0] - start) / t.time_step - np.asarray(velocity)
+
+
 def slide(models, bodies, speeds):
-    """The change of speed in one step of each body pushed along x on the floor, mean over the
-    bodies, against Coulomb friction: −min(v, μ_body·μ_floor·g·dt)."""
-    print("| model | " + " | ".join(f"{v} m/s" for v in speeds) + " |")
-    print("|---|" + "---|" * len(speeds))
+    """Each body pushed along +x, −x, +y and −y on the floor: the odd part of its change of speed
+    in one step (what reverses with the push: friction), mean over bodies and directions, against
+    Coulomb friction, −min(v, μ_body·μ_floor·g·dt); and the change with no push at all (a bias
+    that no push direction explains), mean over bodies, in x and y."""
+    print("| model | bias x, y | " + " | ".join(f"{v} m/s" for v in speeds) + " |")
+    print("|---|---|" + "---|" * len(speeds))
     g_dt = 10.0 * bodies[0][0].time_step
     coulomb = [np.mean([-min(v, t.frictions[o] * FLOOR_FRICTION * g_dt) for t, o in bodies])
                for v in speeds]
-    print("| Coulomb friction | " + " | ".join(f"{c:+.3f}" for c in coulomb) + " |")
+    print("| Coulomb friction | 0, 0 | " + " | ".join(f"{c:+.3f}" for c in coulomb) + " |")
     for path in models:
         model = fignet.load_model(path)
+        bias = np.mean([speed_change(model, t, o, (0.0, 0.0, 0.0)) for t, o in bodies], axis=0)
         changes = []
         for v in speeds:
-            dv = []
+            odd = []
             for t, o in bodies:
-                scene = alone_at_rest(model, t, o, velocity=(v, 0.0, 0.0))
-                start = scene.positions[0].copy()
-                scene.step(1)
-                dv.append((scene.positions[0] - start)[0] / t.time_step - v)
-            changes.append(np.mean(dv))
-        print(f"| {path.name} | " + " | ".join(f"{c:+.3f}" for c in changes) + " |")
+                for axis in (0, 1):
+                    push = np.zeros(3)
+                    push[axis] = v
+                    ahead, back = speed_change(model, t, o, push), speed_change(model, t, o, -push)
+                    odd.append((ahead[axis] - back[axis]) / 2)
+            changes.append(np.mean(odd))
+        print(f"| {path.name} | {bias[0]:+.4f}, {bias[1]:+.4f} | "
+              + " | ".join(f"{c:+.3f}" for c in changes) + " |")
 
 
 def main():
@@ -106,7 +120,8 @@ def main():
     parser.add_argument("--trace", action="store_true",
                         help="print each model's path of the first body instead")
     parser.add_argument("--slide", action="store_true",
-                        help="print the bodies' change of speed in one step when pushed instead")
+                        help="print the friction the model applies in one step to pushed bodies, "
+                             "and its bias at rest, instead")
     args = parser.parse_args()
 
     bodies = resting_bodies(fignet.read_trajectories(args.data), frames=10, tolerance=1e-4)
@@ -114,8 +129,9 @@ def main():
     if not bodies:
         raise SystemExit(f"{args.data}: no body rests over its last 10 frames")
     if args.slide:
-        print(f"{len(bodies)} bodies of {args.data.name} pushed along x on the floor: change of "
-              "speed in the first step (m/s), mean\n")
+        print(f"{len(bodies)} bodies of {args.data.name} pushed along ±x and ±y on the floor: "
+              "the part of the change of speed in the first step that reverses with the push "
+              "(friction), and the change with no push (bias), m/s, mean\n")
         slide(args.model, bodies, [0.01, 0.03, 0.1, 0.3, 1.0, 3.0])
         return
     if args.trace:

@@ -107,7 +107,8 @@ void apply_resume_settings(const std::vector<std::string>& settings, TrainingCon
     if (!TrainingConfig::changes_on_resume(name)) {
       throw ConfigError(fmt::format(
           "--set {}: a resumed run keeps its model's fields (the checkpoint has {} = {}); only "
-          "the training noise and the trainer's fields (batch_size and after in --help's list) "
+          "the training noise, random_yaw and the trainer's fields (batch_size and after in "
+          "--help's list) "
           "may change",
           name, name, config.field_text(name)));
     }
@@ -121,6 +122,7 @@ void apply_resume_settings(const std::vector<std::string>& settings, TrainingCon
   config.model.noise_std = changed.model.noise_std;
   config.model.noise = changed.model.noise;
   config.model.noise_correction = changed.model.noise_correction;
+  config.model.random_yaw = changed.model.random_yaw;
 }
 
 void run_train(const TrainArgs& args) {
@@ -338,7 +340,8 @@ void add_train_command(CLI::App& app) {
   cmd->add_flag("--resume", args->resume,
                 "Continue the run in the checkpoint file exactly where it stopped, with its "
                 "config; --steps and --set of the training noise (noise_std, noise, "
-                "noise_correction) and the trainer's fields (batch_size onwards) may change it")
+                "noise_correction), random_yaw and the trainer's fields (batch_size onwards) may "
+                "change it")
       ->excludes(preset)
       ->excludes(config);
   cmd->add_option("--checkpoint-minutes", args->checkpoint_minutes, "Minutes between checkpoints")

@@ -22,6 +22,7 @@ class ModelFile : public testing::TempFolderTest {
     config.message_passing_steps = 2;
     config.seed = 42;
     config.noise_correction = 0.25;
+    config.random_yaw = true;
     config.graph.face_span_limit = 0.75;
     config.graph.velocity_log_scale = 1e-4;
     Model fresh(config);
@@ -59,6 +60,7 @@ TEST_F(ModelFile, SaveThenLoadIsBitExact) {
   EXPECT_EQ(loaded.config().graph.collision_radius, model_->config().graph.collision_radius);
   EXPECT_EQ(loaded.config().time_step, model_->config().time_step);
   EXPECT_EQ(loaded.config().noise_correction, 0.25);
+  EXPECT_TRUE(loaded.config().random_yaw);
   EXPECT_EQ(loaded.config().graph.face_span_limit, 0.75);
   EXPECT_EQ(loaded.config().graph.velocity_log_scale, 1e-4);
   EXPECT_EQ(loaded.normalizers().mesh_node.sum(), model_->normalizers().mesh_node.sum());

@@ -60,6 +60,7 @@ void write_config(H5::Group group, const ModelConfig& c) {
   write_attribute(group, "velocity_log_scale", c.graph.velocity_log_scale);
   write_attribute(group, "noise", std::string(c.noise == NoiseKind::kRigid ? "rigid" : "vertex"));
   write_attribute(group, "noise_correction", c.noise_correction);
+  write_attribute(group, "random_yaw", static_cast<long long>(c.random_yaw));
 }
 
 ModelConfig read_config(const H5::Group& group) {
@@ -119,6 +120,7 @@ ModelConfig read_config(const H5::Group& group) {
   if (group.attrExists("noise_correction")) {
     c.noise_correction = read_double(group, "noise_correction");
   }
+  c.random_yaw = flag("random_yaw", false);
   c.validate();
   return c;
 }

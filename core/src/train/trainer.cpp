@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 
 #include "fignet/error.h"
 #include "parallel/parallel_for.h"
@@ -127,6 +128,11 @@ void Trainer::build_batch_graph(const std::vector<SampleRef>& batch, std::mt1993
       make_noisy_sample(data_[batch[b].trajectory], batch[b].frame, h, config_.noise_std,
                         config_.noise, config_.noise_correction, rng, scenes_[b],
                         scene_targets_[b]);
+      // Drawn after the noise: a run without the turn draws the same noise as before it existed.
+      if (config_.random_yaw) {
+        std::uniform_real_distribution<double> angle(0.0, 2.0 * std::numbers::pi);
+        turn_about_vertical(angle(rng), scenes_[b], scene_targets_[b]);
+      }
       if (weighs_rest()) {
         const Trajectory& trajectory = data_[batch[b].trajectory];
         scene_resting_[b] =

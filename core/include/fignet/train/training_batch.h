@@ -30,6 +30,12 @@ void make_noisy_sample(const Trajectory& trajectory, int frame, int history, dou
                        NoiseKind kind, double position_correction, std::mt19937_64& rng,
                        Scene& scene, Points& targets);
 
+// Turns a sample (every object's positions, centres and kinematic next poses, and the target
+// rows) by `angle` radians about the vertical axis through the floor's centre (the origin when
+// the scene has no floor). Gravity and the floor plane are unchanged by the turn, so the turned
+// sample is as true as the original.
+void turn_about_vertical(double angle, Scene& scene, Points& targets);
+
 // Per object of the trajectory: 1 where the body is dynamic and at rest in the truth around the
 // sample, that is every vertex moves less than `max_step` metres over frame − 1 → frame and
 // frame → frame + 1 (a body at the top of a free flight still moves g·dt/2 per step).
