@@ -108,8 +108,7 @@ void apply_resume_settings(const std::vector<std::string>& settings, TrainingCon
       throw ConfigError(fmt::format(
           "--set {}: a resumed run keeps its model's fields (the checkpoint has {} = {}); only "
           "the training noise, random_yaw and the trainer's fields (batch_size and after in "
-          "--help's list) "
-          "may change",
+          "--help's list) may change",
           name, name, config.field_text(name)));
     }
     if (name == "steps") continue;  // --steps has the last word on the run's length
@@ -118,11 +117,9 @@ void apply_resume_settings(const std::vector<std::string>& settings, TrainingCon
                  changed.field_text(name));
     }
   }
+  // Every model field that differs passed changes_on_resume above: the model may be taken whole.
   config.trainer = changed.trainer;
-  config.model.noise_std = changed.model.noise_std;
-  config.model.noise = changed.model.noise;
-  config.model.noise_correction = changed.model.noise_correction;
-  config.model.random_yaw = changed.model.random_yaw;
+  config.model = changed.model;
 }
 
 void run_train(const TrainArgs& args) {

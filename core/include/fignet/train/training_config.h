@@ -21,10 +21,10 @@ struct TrainingConfig {
   bool decay_steps_given = false;
 
   // The model preset ("paper" or "small") trained with the recipe of docs/training-study.md:
-  // batch 8, the parameters' moving average (0.999) as the model, rigid-body noise, log mass, no
-  // edges inside static bodies, normalisers frozen after 800 warm-up batches, gradients clipped
-  // to norm 1, Huber loss beyond 3σ.
-  // A default-constructed TrainingConfig keeps the first recipe (batch 4, vertex noise, ...),
+  // batch 8, the parameters' moving average (0.999) as the model, rigid-body noise, log mass,
+  // velocities also as logarithms (velocity_log_scale 1e-4), no edges inside static bodies,
+  // normalisers frozen after 800 warm-up batches, gradients clipped to norm 1, Huber loss beyond
+  // 3σ. A default-constructed TrainingConfig keeps the first recipe (batch 4, vertex noise, ...),
   // which is what checkpoint and model files without these fields were trained with.
   static TrainingConfig preset_named(std::string_view name);
 
@@ -41,9 +41,9 @@ struct TrainingConfig {
   // resumed run cannot change; the others are the trainer's (loss, optimizer, sampling) and the
   // run's length.
   static bool is_model_field(std::string_view name);
-  // Whether a resumed run may change the field (--set on --resume): the trainer's fields and the
-  // training noise (noise_std, noise, noise_correction), which shape the samples but not the
-  // parameters or the normalisers.
+  // Whether a resumed run may change the field (--set on --resume): the trainer's fields, the
+  // training noise (noise_std, noise, noise_correction) and random_yaw, which shape the samples
+  // but not the parameters or the normalisers.
   static bool changes_on_resume(std::string_view name);
   // The fields whose values differ from `other`'s, in documentation order.
   std::vector<std::string> differing_fields(const TrainingConfig& other) const;
