@@ -31,8 +31,9 @@ struct ModelConfig {
   // learns to pull a displaced or penetrating body back where the truth has it).
   double noise_correction = 0.0;
   // Turn each training sample about the vertical (z) axis by a uniform random angle: the physics
-  // has no preferred horizontal direction. On one seed it lowered rollout error by 4-9 % but did
-  // not remove the constant sideways push that models give a body at rest (training study).
+  // has no preferred horizontal direction. Measured on two seeds it helped one (-4 % test error)
+  // and hurt the other (+10 %), and did not remove the sideways push models give a body at rest
+  // (training study).
   bool random_yaw = false;
   std::int64_t normalizer_max_accumulations = 1'000'000;  // statistics freeze afterwards
   double time_step = 1.0 / 48.0;   // seconds between the frames the model was trained on
