@@ -38,11 +38,14 @@ def resting_bodies(trajectories, frames, tolerance):
 FLOOR_FRICTION = 0.3  # MOVi's floor (reference/facts.md); Bullet multiplies the two frictions
 
 
+TURNS = 1  # --turns
+
+
 def alone_at_rest(model, t, o, velocity=(0.0, 0.0, 0.0)):
     """A scene of the body alone at its recorded rest pose (sliding at `velocity`, m/s), stepped
     by the network alone."""
     scene = fignet.Scene(model, free_flight=False, sleeping=False, penetration_guard=False,
-                         rest_guard=False)
+                         rest_guard=False, turns=TURNS)
     scene.add_floor(height=t.floor_height, friction=FLOOR_FRICTION)
     scene.add_body(t.vertices(o), t.faces(o), mass=t.masses[o], friction=t.frictions[o],
                    restitution=t.restitutions[o], position=t.positions[-1, o],
@@ -122,7 +125,12 @@ def main():
     parser.add_argument("--slide", action="store_true",
                         help="print the friction the model applies in one step to pushed bodies, "
                              "and its bias at rest, instead")
+    parser.add_argument("--turns", type=int, default=1,
+                        help="average each prediction over the scene turned by k/turns of a turn "
+                             "about the vertical (1: off)")
     args = parser.parse_args()
+    global TURNS
+    TURNS = args.turns
 
     bodies = resting_bodies(fignet.read_trajectories(args.data), frames=10, tolerance=1e-4)
     bodies = bodies[: args.bodies]

@@ -24,7 +24,7 @@ namespace fs = std::filesystem;
 struct CompareArgs {
   std::vector<fs::path> models;
   fs::path data, report = "fignet-report.html", json;
-  int max_scenes = 5, frames = -1, threads = 1;
+  int max_scenes = 5, frames = -1, threads = 1, turns = 1;
 };
 
 void print_table(const std::vector<bullet::RunResult>& results) {
@@ -66,7 +66,10 @@ void run_compare(const CompareArgs& args) {
     }
   }
   std::vector<bullet::ComparisonRun> runs = bullet::standard_runs(models, names);
-  for (bullet::ComparisonRun& run : runs) run.world_options.threads = args.threads;
+  for (bullet::ComparisonRun& run : runs) {
+    run.world_options.threads = args.threads;
+    run.world_options.turns = args.turns;
+  }
   ProgressBar progress("compare", static_cast<long long>(runs.size() * scenes.size()));
   const std::vector<bullet::RunResult> results =
       bullet::compare_runs(scenes, runs, [&](int run, int scene) {
@@ -117,6 +120,11 @@ void add_compare_command(CLI::App& app) {
                   "only helps large scenes on an otherwise idle machine)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--turns", args->turns,
+                  "Average each prediction over the scene turned by k/turns of a turn about the "
+                  "vertical (FIGNetWorldOptions::turns; turns times the network's cost)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
   cmd->callback([args] { run_compare(*args); });
 }
 

@@ -28,7 +28,7 @@ namespace fs = std::filesystem;
 struct EvalArgs {
   std::vector<fs::path> models, data;
   fs::path json;
-  int frames = -1, max_trajectories = -1, threads = 1;
+  int frames = -1, max_trajectories = -1, threads = 1, turns = 1;
   bool baseline = true, penetration = true, regimes = true;
 };
 
@@ -224,7 +224,7 @@ void run_eval(const EvalArgs& args) {
                                     file.string(), config.time_step, test[0].time_step));
     }
     history = config.graph.history;
-    ModelPredictor predictor(model, args.threads);
+    ModelPredictor predictor(model, {.threads = args.threads, .turns = args.turns});
     const std::string name = file.filename().string();
     rows.push_back(evaluate(name, kind_of(config), predictor, test, args));
     if (args.regimes) {
@@ -299,6 +299,11 @@ void add_eval_command(CLI::App& app) {
                   "only helps large scenes on an otherwise idle machine)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--turns", args->turns,
+                  "Average each prediction over the scene turned by k/turns of a turn about the "
+                  "vertical (PredictionOptions::turns; turns times the cost)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
   cmd->callback([args] { run_eval(*args); });
 }
 

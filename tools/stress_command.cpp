@@ -24,6 +24,7 @@ struct StressArgs {
   fs::path markdown;
   std::string only;
   double length = 1.0;
+  int turns = 1;
   std::string command_line;
 };
 
@@ -49,7 +50,7 @@ void run_stress(const StressArgs& args) {
   for (const fs::path& file : args.models) {
     models.emplace_back(file.filename().string(), std::make_shared<const Model>(load_model(file)));
   }
-  const std::vector<bullet::Simulator> sims = bullet::stress_simulators(models);
+  const std::vector<bullet::Simulator> sims = bullet::stress_simulators(models, args.turns);
   std::vector<bullet::StressCase> cases = bullet::stress_cases(args.length);
   std::erase_if(cases, [&](const bullet::StressCase& c) {
     return !args.only.empty() && c.name.find(args.only) == std::string::npos &&
@@ -127,11 +128,17 @@ void add_stress_command(CLI::App& app) {
                   "Scale every case's length (1: as specified, e.g. 2000 steps at rest)")
       ->check(CLI::Range(0.001, 10.0))
       ->capture_default_str();
+  cmd->add_option("--turns", args->turns,
+                  "Average each prediction over the scene turned by k/turns of a turn about the "
+                  "vertical: cancels the model's sideways push at rest, at turns times the cost")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
   cmd->callback([args] {
     std::string line = "build/release/tools/fignet stress";
     for (const fs::path& m : args->models) line += " --model " + m.string();
     if (!args->only.empty()) line += " --case '" + args->only + "'";
     if (args->length != 1.0) line += fmt::format(" --length {}", args->length);
+    if (args->turns != 1) line += fmt::format(" --turns {}", args->turns);
     if (!args->markdown.empty()) line += " --markdown " + args->markdown.string();
     args->command_line = line;
     run_stress(*args);

@@ -192,7 +192,7 @@ std::vector<StressCase> stress_cases(double scale_frames) {
 }
 
 std::vector<Simulator> stress_simulators(
-    const std::vector<std::pair<std::string, std::shared_ptr<const Model>>>& models) {
+    const std::vector<std::pair<std::string, std::shared_ptr<const Model>>>& models, int turns) {
   std::vector<Simulator> sims;
   sims.push_back({"Bullet 240 Hz", {}, {}});
   for (const auto& [name, model] : models) {
@@ -201,9 +201,13 @@ std::vector<Simulator> stress_simulators(
     std::shared_ptr<const Model> shared = model;
     // The network alone (what the model itself does), then the world as users get it.
     for (const bool alone : {true, false}) {
-      const FIGNetWorldOptions options =
+      FIGNetWorldOptions options =
           alone ? FIGNetWorldOptions::network_alone() : FIGNetWorldOptions{};
-      sims.push_back({fmt::format("FIGNet {}{}", name, alone ? " (network alone)" : ""), one_step,
+      options.turns = turns;
+      std::string variant = alone ? "network alone" : "";
+      if (turns > 1) variant += fmt::format("{}{} turns", variant.empty() ? "" : ", ", turns);
+      if (!variant.empty()) variant = " (" + variant + ")";
+      sims.push_back({fmt::format("FIGNet {}{}", name, variant), one_step,
                       [shared, options](btDispatcher* d, btBroadphaseInterface* b,
                                         btConstraintSolver* s, btCollisionConfiguration* c) {
                         return std::make_unique<FIGNetDynamicsWorld>(d, b, s, c, shared, options);

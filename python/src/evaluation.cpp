@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "bindings.h"
+#include "fignet/error.h"
 #include "fignet/rollout/evaluation.h"
 
 namespace fignet::python {
@@ -102,9 +103,10 @@ angle (degrees); their means over frames first_predicted … end and their last 
   m.def(
       "evaluate",
       [](const std::shared_ptr<Model>& model, const std::vector<Trajectory>& trajectories,
-         int frames, bool penetration, int threads) {
+         int frames, bool penetration, int threads, int turns) {
         if (trajectories.empty()) throw py::value_error("evaluate: no trajectories");
         for (const Trajectory& t : trajectories) t.validate();
+        if (turns < 1) throw ConfigError(fmt::format("evaluate: turns = {} (must be >= 1)", turns));
         EvaluationOptions options;
         options.frames = frames;
         options.penetration = penetration;
@@ -113,8 +115,11 @@ angle (degrees); their means over frames first_predicted … end and their last 
           py::gil_scoped_release release;
           const std::shared_ptr<const Model> shared = model;
           e = evaluate_rollouts_parallel(
-              [&] { return std::make_unique<ModelPredictor>(shared, 1); }, trajectories,
-              std::max(1, threads), options);
+              [&] {
+                return std::make_unique<ModelPredictor>(
+                    shared, PredictionOptions{.threads = 1, .turns = turns});
+              },
+              trajectories, std::max(1, threads), options);
         }
         py::dict out;
         out["trajectories"] = e.trajectories;
@@ -134,9 +139,9 @@ angle (degrees); their means over frames first_predicted … end and their last 
         return out;
       },
       py::arg("model"), py::arg("trajectories"), py::arg("frames") = -1,
-      py::arg("penetration") = false, py::arg("threads") = 1,
+      py::arg("penetration") = false, py::arg("threads") = 1, py::arg("turns") = 1,
       R"(Rolls every trajectory out with the network alone and summarises as `fignet eval --json`
-does (the same keys): mean and last-frame errors averaged over trajectories, per-frame means,
+does (the same keys; `turns` as its --turns): mean and last-frame errors averaged over trajectories, per-frame means,
 penetration ratios when asked (costly), and each trajectory's errors.)");
 }
 

@@ -25,8 +25,11 @@ using bullet::SceneSpec;
 class PyScene {
  public:
   PyScene(std::shared_ptr<Model> model, bool free_flight, bool sleeping, bool penetration_guard,
-          bool sweep_guard, int threads, std::optional<int> graph_vertices, bool rest_guard)
+          bool sweep_guard, int threads, std::optional<int> graph_vertices, bool rest_guard,
+          int turns)
       : model_(std::move(model)) {
+    if (turns < 1)
+      throw ConfigError(fmt::format("Scene: turns = {} (must be >= 1; 1: off)", turns));
     if (graph_vertices) options_.max_graph_vertices = *graph_vertices;
     options_.free_flight = free_flight;
     options_.sleeping = sleeping;
@@ -34,6 +37,7 @@ class PyScene {
     options_.sweep_guard = sweep_guard;
     options_.rest_guard = rest_guard;
     options_.threads = threads;
+    options_.turns = turns;
     if (model_) {
       // Frames at the model's step, Bullet's 240 Hz substeps for the native reference.
       spec_.gravity = model_->config().gravity;
@@ -215,14 +219,16 @@ are pushed out (penetration_guard), and bodies that stand at rest stay where the
 Coulomb's static friction under gravity (rest_guard); turn all four off for the network alone, as
 `fignet eval` measures it. A mesh finer than the model was trained on enters the graph simplified to
 `graph_vertices` (default None: the model's own resolution, 64 for MOVi-A; 0: never) within 2 %
-of its size; Bullet still collides the full mesh. Without a model, native Bullet steps at 240 Hz,
+of its size; Bullet still collides the full mesh. `turns` > 1 predicts each frame that
+many times, the scene turned by k/turns of a turn about the vertical, and averages: it cancels the
+sideways push a model gives resting bodies, at `turns` times the cost. Without a model, native Bullet steps at 240 Hz,
 5 substeps per frame.)")
-      .def(
-          py::init<std::shared_ptr<Model>, bool, bool, bool, bool, int, std::optional<int>, bool>(),
-          py::arg("model") = py::none(), py::arg("free_flight") = true, py::arg("sleeping") = true,
-          py::arg("penetration_guard") = true, py::arg("sweep_guard") = true,
-          py::arg("threads") = 1, py::arg("graph_vertices") = py::none(),
-          py::arg("rest_guard") = true)
+      .def(py::init<std::shared_ptr<Model>, bool, bool, bool, bool, int, std::optional<int>, bool,
+                    int>(),
+           py::arg("model") = py::none(), py::arg("free_flight") = true, py::arg("sleeping") = true,
+           py::arg("penetration_guard") = true, py::arg("sweep_guard") = true,
+           py::arg("threads") = 1, py::arg("graph_vertices") = py::none(),
+           py::arg("rest_guard") = true, py::arg("turns") = 1)
       .def(
           "add_body",
           [](PyScene& scene, const py::handle& vertices, const py::handle& faces,

@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "../graph/scene_fixtures.h"
@@ -271,11 +272,11 @@ TEST(Model, RolloutThroughAModelIsFiniteAndCountsFaceEdges) {
   EXPECT_GT(face_edges.front(), 0);  // cube–floor face pairs within d_c = 0.1 m
 }
 
-TEST(Model, OutputIsEquivariantToObjectOrder) {
+// A model with random weights and normalisers fitted to `scene`, so that neither is at its
+// symmetric initial value.
+std::shared_ptr<const Model> random_model(const Scene& scene) {
   ModelConfig config = small_model();
   config.latent_size = 16;
-  auto fixture = testing::make_random_scene(13, 5, 0.6);
-  // Train a few steps so normalisers and weights are not at their symmetric initial values.
   Model fresh(config);
   std::vector<float> params = fresh.parameters();
   std::mt19937 rng(1);
@@ -283,11 +284,15 @@ TEST(Model, OutputIsEquivariantToObjectOrder) {
   for (float& p : params) p += noise(rng);
   Normalizers normalizers = fresh.normalizers();
   Graph graph;
-  GraphBuilder(config.graph).build(fixture.scene, graph);
+  GraphBuilder(config.graph).build(scene, graph);
   normalizers.mesh_node.accumulate(graph.mesh_nodes.matrix());
   normalizers.face_edge.accumulate(graph.face_edges.features.matrix());
-  auto model = std::make_shared<const Model>(config, params, normalizers);
-  ModelPredictor predictor(model);
+  return std::make_shared<const Model>(config, params, normalizers);
+}
+
+TEST(Model, OutputIsEquivariantToObjectOrder) {
+  auto fixture = testing::make_random_scene(13, 5, 0.6);
+  ModelPredictor predictor(random_model(fixture.scene));
   Points original, permuted;
   predictor.predict(fixture.scene, original);
   Scene reversed = fixture.scene;
@@ -307,6 +312,68 @@ TEST(Model, OutputIsEquivariantToObjectOrder) {
     EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-5 * (1.0 + a.cwiseAbs().maxCoeff()))
         << "object " << o;
   }
+}
+
+// Largest difference of the predictions of `scene` and of `scene` turned by `angle` about the
+// vertical, the second turned back, relative to the first's largest value.
+double turned_prediction_difference(ModelPredictor& predictor, const Scene& scene, double angle) {
+  Points direct, turned;
+  predictor.predict(scene, direct);
+  Scene copy = scene;
+  turn_about_vertical(angle, copy);
+  predictor.predict(copy, turned);
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, Vec3::UnitZ()).toRotationMatrix();
+  return (turned * turn - direct).cwiseAbs().maxCoeff() / direct.cwiseAbs().maxCoeff();
+}
+
+TEST(ModelPredictor, PredictionsAveragedOverTurnsTurnWithTheScene) {
+  // Averaged over k/n turns, a prediction is equivariant to those turns, whatever the weights; a
+  // single one is not. The scenes have collision edges but no overlapping faces: the closest
+  // points of two crossing triangles jump with rounding, so that even a full turn changes such a
+  // scene's prediction. The mesh floor's two triangles map onto themselves under a half turn
+  // about its centre, not under a quarter turn: the quarter-turn scene's bodies are off the floor.
+  const auto on_floor = testing::make_random_scene(13, 5, 2.0);
+  const auto in_air = testing::make_random_scene(17, 5, 2.0);
+  auto model = random_model(on_floor.scene);
+  const double half = std::numbers::pi, quarter = std::numbers::pi / 2;
+  ModelPredictor single(model), two(model, {.turns = 2}), four(model, {.turns = 4});
+  EXPECT_LT(turned_prediction_difference(single, on_floor.scene, 2 * half), 1e-12);
+  EXPECT_GT(single.last_face_edges(), 0);
+  EXPECT_LT(turned_prediction_difference(single, in_air.scene, 2 * half), 1e-12);
+  EXPECT_GT(single.last_face_edges(), 0);
+
+  EXPECT_GT(turned_prediction_difference(single, on_floor.scene, half), 1e-2);
+  EXPECT_LT(turned_prediction_difference(two, on_floor.scene, half), 1e-5);
+  EXPECT_GT(turned_prediction_difference(two, in_air.scene, quarter), 1e-2);
+  EXPECT_LT(turned_prediction_difference(four, in_air.scene, quarter), 1e-5);
+  EXPECT_LT(turned_prediction_difference(four, in_air.scene, half), 1e-5);
+}
+
+TEST(ModelPredictor, TurnAveragingCancelsAConstantHorizontalBias) {
+  // Zero weights: the network's output is 0 in normalised units, so every node is predicted the
+  // target normaliser's mean b (std 1). Turned back, the half-turned scene's prediction is
+  // (−b_x, −b_y, b_z): the average keeps b_z alone.
+  auto fixture = testing::make_random_scene(7, 3, 0.6);
+  const ModelConfig config = small_model();
+  const Model fresh(config);
+  Normalizers normalizers = fresh.normalizers();
+  const Eigen::Vector3d bias(0.3, -0.2, -4.0);
+  normalizers.target.set_state(1, 1.0, bias, bias.cwiseAbs2().array() + 1.0);
+  auto model = std::make_shared<const Model>(
+      config, std::vector<float>(fresh.parameters().size(), 0.0f), normalizers);
+  Points single, averaged;
+  ModelPredictor(model).predict(fixture.scene, single);
+  ModelPredictor(model, {.turns = 2}).predict(fixture.scene, averaged);
+  for (Eigen::Index i = 0; i < single.rows(); ++i) {
+    EXPECT_NEAR((single.row(i).transpose() - bias).norm(), 0.0, 1e-6);
+    EXPECT_NEAR((averaged.row(i).transpose() - Vec3(0, 0, bias.z())).norm(), 0.0, 1e-6);
+  }
+}
+
+TEST(ModelPredictor, RejectsTurnsBelowOne) {
+  auto fixture = testing::make_random_scene(7, 2, 0.6);
+  auto model = random_model(fixture.scene);
+  EXPECT_THROW(ModelPredictor(model, {.turns = 0}), ConfigError);
 }
 
 }  // namespace

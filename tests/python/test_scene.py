@@ -139,3 +139,21 @@ def test_a_fine_mesh_enters_the_graph_within_the_node_budget(model):
     # The model's resolution (at most 1000 when its file predates it) within 2 %, or none.
     assert 0 < nodes[None] < 400
     assert nodes[0] >= len(vertices)
+
+
+def test_turn_averaging_cancels_the_models_sideways_push_at_rest(model):
+    # The shipped model pushes a resting body sideways whatever its surroundings; predictions
+    # averaged with the scene turned half a turn cancel that push (FIGNetWorldOptions::turns).
+    moved = {}
+    for turns in (1, 2):
+        scene = fignet.Scene(model, free_flight=False, sleeping=False, penetration_guard=False,
+                             rest_guard=False, turns=turns)
+        scene.add_floor()
+        vertices, faces = box(0.35)
+        start = np.array([0.2, -0.1, 0.35])
+        scene.add_body(vertices, faces, density=2700, position=start)
+        scene.step(48)
+        moved[turns] = np.linalg.norm(scene.positions[0, :2] - start[:2])
+    assert moved[2] < 0.5 * moved[1], moved
+    with pytest.raises(ValueError, match="turns"):
+        fignet.Scene(model, turns=0).step(1)

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <numbers>
+
 #include "fignet/error.h"
 
 namespace fignet {
@@ -16,29 +18,57 @@ Eigen::Index count_nodes(const Scene& scene) {
 
 }  // namespace
 
-ModelPredictor::ModelPredictor(std::shared_ptr<const Model> model, int threads)
-    : model_(std::move(model)), builder_(model_->config().graph), threads_(threads) {
-  if (threads < 0) {
-    throw ConfigError(fmt::format("ModelPredictor: {} threads (must be >= 0)", threads));
+ModelPredictor::ModelPredictor(std::shared_ptr<const Model> model, const PredictionOptions& options)
+    : model_(std::move(model)), options_(options), builder_(model_->config().graph) {
+  if (options.threads < 0) {
+    throw ConfigError(fmt::format("ModelPredictor: {} threads (must be >= 0)", options.threads));
+  }
+  if (options.turns < 1) {
+    throw ConfigError(
+        fmt::format("ModelPredictor: {} turns (must be >= 1; 1: off)", options.turns));
   }
 }
 
-void ModelPredictor::predict(const Scene& scene, Points& accelerations) {
-  builder_.build(scene, graph_);
+template <typename Build>
+void ModelPredictor::predict_averaged(const Scene& scene, Build&& build, Points& accelerations) {
+  // The turned scenes first, so that last_graph() is the scene's own.
+  for (int k = 1; k < options_.turns; ++k) {
+    const double angle = 2.0 * std::numbers::pi * k / options_.turns;
+    turned_ = scene;  // copy-assigned: a steady-state step reuses the last one's buffers
+    turn_about_vertical(angle, turned_);
+    build(turned_);
+    run_network(turned_, turned_accelerations_);
+    // Row vectors turned by a ↦ a·Rᵀ turn back by a ↦ a·R.
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, Vec3::UnitZ()).toRotationMatrix();
+    if (k == 1) {
+      turned_sum_.noalias() = turned_accelerations_ * turn;
+    } else {
+      turned_sum_.noalias() += turned_accelerations_ * turn;
+    }
+  }
+  build(scene);
   run_network(scene, accelerations);
+  if (options_.turns > 1) accelerations = (accelerations + turned_sum_) / options_.turns;
+}
+
+void ModelPredictor::predict(const Scene& scene, Points& accelerations) {
+  predict_averaged(
+      scene, [&](const Scene& s) { builder_.build(s, graph_); }, accelerations);
 }
 
 void ModelPredictor::predict_with_candidates(const Scene& scene,
                                              std::span<const ObjectPair> candidates,
                                              Points& accelerations) {
-  builder_.build_with_candidates(scene, candidates, graph_);
-  run_network(scene, accelerations);
+  // A turn about the vertical moves no object into or out of a pair: the candidates stand.
+  predict_averaged(
+      scene, [&](const Scene& s) { builder_.build_with_candidates(s, candidates, graph_); },
+      accelerations);
 }
 
 void ModelPredictor::run_network(const Scene& scene, Points& accelerations) {
   // Eigen's thread count is process-wide: set ours for the forward pass, then give it back.
   const int previous = Eigen::nbThreads();
-  if (threads_ > 0) Eigen::setNbThreads(threads_);
+  if (options_.threads > 0) Eigen::setNbThreads(options_.threads);
   const ConstMatrixView normalized = model_->network().forward(
       model_->parameters().data(), model_->normalizers(), graph_, workspace_, false);
   Eigen::setNbThreads(previous);

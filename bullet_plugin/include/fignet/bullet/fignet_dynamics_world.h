@@ -85,9 +85,13 @@ struct FIGNetWorldOptions {
     options.rest_guard = false;
     return options;
   }
-  // Threads for the network's matrix products (see ModelPredictor; 0: every core). One keeps
+  // Threads for the network's matrix products (see PredictionOptions; 0: every core). One keeps
   // a step from stalling behind the host program's own threads.
   int threads = 1;
+  // Predictions averaged over the scene turned by k/turns of a turn about the vertical (see
+  // PredictionOptions::turns): cancels the model's own sideways push on resting bodies, at
+  // `turns` times the network's cost. 1: off. Only for worlds built from a model.
+  int turns = 1;
 };
 
 // What the last internal step simulated and what it cost.

@@ -44,9 +44,11 @@ struct Simulator {
   WorldFactory make_world;  // none: native Bullet
 };
 
-// Native Bullet at 240 Hz and, per model, a FIGNet world stepping once per frame.
+// Native Bullet at 240 Hz and, per model, a FIGNet world stepping once per frame: the network
+// alone, then the world as users get it, both averaging over `turns` headings
+// (FIGNetWorldOptions::turns).
 std::vector<Simulator> stress_simulators(
-    const std::vector<std::pair<std::string, std::shared_ptr<const Model>>>& models);
+    const std::vector<std::pair<std::string, std::shared_ptr<const Model>>>& models, int turns = 1);
 
 // Runs one case on each simulator (the first is the reference for `error`).
 std::vector<StressRun> run_stress_case(const StressCase& c, const std::vector<Simulator>& sims);

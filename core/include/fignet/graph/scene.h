@@ -69,4 +69,9 @@ struct Scene {
   std::optional<Floor> floor;  // used when GraphConfig::floor is kMesh or kImplicit
 };
 
+// Turns every object's positions, centres and kinematic next poses by `angle` radians about the
+// vertical axis through the floor's centre (the origin when the scene has no floor). Gravity and
+// the floor are unchanged by the turn, so the turned scene is as true as the original.
+void turn_about_vertical(double angle, Scene& scene);
+
 }  // namespace fignet

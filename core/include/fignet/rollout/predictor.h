@@ -31,13 +31,28 @@ class AccelerationPredictor {
   virtual int last_face_edges() const { return 0; }
 };
 
+// How a ModelPredictor runs its model.
+struct PredictionOptions {
+  // Threads for Eigen's matrix products (0: Eigen's default, every core). One by default: a
+  // step's products are small, and threads that wait for a core another program holds stall
+  // each product by a scheduler time slice, which made steps many times slower on a busy machine.
+  int threads = 1;
+  // Predict the scene `turns` times, turned by k/turns of a full turn about the vertical
+  // (k = 0 … turns − 1), and average the predictions turned back. True accelerations turn with
+  // the scene, so the average keeps what the predictions agree on and cancels horizontal
+  // accelerations the model adds whatever the scene's heading: trained models carry a bias of
+  // ~0.15 mm/step² in a direction of their own (docs/training-study.md) that slides resting
+  // bodies sideways. 2 (a half turn) cancels a constant bias; 4 also what changes with the
+  // heading as cos θ or sin θ. Costs `turns` predictions; 1: off.
+  int turns = 1;
+};
+
 // Runs a FIGNet model: builds the graph, runs the network, un-normalises. One per thread.
 class ModelPredictor : public AccelerationPredictor {
  public:
-  // `threads` for Eigen's matrix products (0: Eigen's default, every core). One by default: a
-  // step's products are small, and threads that wait for a core another program holds stall
-  // each product by a scheduler time slice, which made steps many times slower on a busy machine.
-  explicit ModelPredictor(std::shared_ptr<const Model> model, int threads = 1);
+  ModelPredictor(std::shared_ptr<const Model> model, const PredictionOptions& options);
+  explicit ModelPredictor(std::shared_ptr<const Model> model, int threads = 1)
+      : ModelPredictor(std::move(model), PredictionOptions{.threads = threads}) {}
   int history() const override { return model_->config().graph.history; }
   void predict(const Scene& scene, Points& accelerations) override;
   void predict_with_candidates(const Scene& scene, std::span<const ObjectPair> candidates,
@@ -50,13 +65,18 @@ class ModelPredictor : public AccelerationPredictor {
  private:
   // Runs the network on graph_ and un-normalises the scene's node rows.
   void run_network(const Scene& scene, Points& accelerations);
+  // Builds the graph with `build`, runs the network and, with turns > 1, averages over turns.
+  template <typename Build>
+  void predict_averaged(const Scene& scene, Build&& build, Points& accelerations);
 
   std::shared_ptr<const Model> model_;
+  PredictionOptions options_;
   GraphBuilder builder_;
   Graph graph_;
   NetworkWorkspace workspace_;
   RowMatrixXf denormalized_;
-  int threads_ = 1;
+  Scene turned_;
+  Points turned_accelerations_, turned_sum_;
 };
 
 // Exact free fall: every node accelerates by gravity·dt² (the ballistic baseline without

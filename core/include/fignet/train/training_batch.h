@@ -30,10 +30,8 @@ void make_noisy_sample(const Trajectory& trajectory, int frame, int history, dou
                        NoiseKind kind, double position_correction, std::mt19937_64& rng,
                        Scene& scene, Points& targets);
 
-// Turns a sample (every object's positions, centres and kinematic next poses, and the target
-// rows) by `angle` radians about the vertical axis through the floor's centre (the origin when
-// the scene has no floor). Gravity and the floor plane are unchanged by the turn, so the turned
-// sample is as true as the original.
+// Turns a sample, its scene (see turn_about_vertical(double, Scene&)) and its target rows, by
+// `angle` radians about the vertical axis through the floor's centre.
 void turn_about_vertical(double angle, Scene& scene, Points& targets);
 
 // Per object of the trajectory: 1 where the body is dynamic and at rest in the truth around the
