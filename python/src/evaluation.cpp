@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 
 #include "bindings.h"
-#include "fignet/error.h"
 #include "fignet/rollout/evaluation.h"
 
 namespace fignet::python {
@@ -106,7 +105,8 @@ angle (degrees); their means over frames first_predicted … end and their last 
          int frames, bool penetration, int threads, int turns) {
         if (trajectories.empty()) throw py::value_error("evaluate: no trajectories");
         for (const Trajectory& t : trajectories) t.validate();
-        if (turns < 1) throw ConfigError(fmt::format("evaluate: turns = {} (must be >= 1)", turns));
+        const PredictionOptions prediction{.threads = 1, .turns = turns};
+        prediction.validate();  // here, not in the worker threads
         EvaluationOptions options;
         options.frames = frames;
         options.penetration = penetration;
@@ -115,11 +115,8 @@ angle (degrees); their means over frames first_predicted … end and their last 
           py::gil_scoped_release release;
           const std::shared_ptr<const Model> shared = model;
           e = evaluate_rollouts_parallel(
-              [&] {
-                return std::make_unique<ModelPredictor>(
-                    shared, PredictionOptions{.threads = 1, .turns = turns});
-              },
-              trajectories, std::max(1, threads), options);
+              [&] { return std::make_unique<ModelPredictor>(shared, prediction); }, trajectories,
+              std::max(1, threads), options);
         }
         py::dict out;
         out["trajectories"] = e.trajectories;

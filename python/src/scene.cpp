@@ -28,8 +28,8 @@ class PyScene {
           bool sweep_guard, int threads, std::optional<int> graph_vertices, bool rest_guard,
           int turns)
       : model_(std::move(model)) {
-    if (turns < 1)
-      throw ConfigError(fmt::format("Scene: turns = {} (must be >= 1; 1: off)", turns));
+    // Checked now: the world, and with it the predictor, is made at the first step.
+    PredictionOptions{.turns = turns}.validate();
     if (graph_vertices) options_.max_graph_vertices = *graph_vertices;
     options_.free_flight = free_flight;
     options_.sleeping = sleeping;

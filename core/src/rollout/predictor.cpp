@@ -18,15 +18,18 @@ Eigen::Index count_nodes(const Scene& scene) {
 
 }  // namespace
 
+void PredictionOptions::validate() const {
+  if (threads < 0) {
+    throw ConfigError(fmt::format("PredictionOptions: {} threads (must be >= 0)", threads));
+  }
+  if (turns < 1) {
+    throw ConfigError(fmt::format("PredictionOptions: {} turns (must be >= 1; 1: off)", turns));
+  }
+}
+
 ModelPredictor::ModelPredictor(std::shared_ptr<const Model> model, const PredictionOptions& options)
     : model_(std::move(model)), options_(options), builder_(model_->config().graph) {
-  if (options.threads < 0) {
-    throw ConfigError(fmt::format("ModelPredictor: {} threads (must be >= 0)", options.threads));
-  }
-  if (options.turns < 1) {
-    throw ConfigError(
-        fmt::format("ModelPredictor: {} turns (must be >= 1; 1: off)", options.turns));
-  }
+  options.validate();
 }
 
 template <typename Build>

@@ -45,6 +45,9 @@ struct PredictionOptions {
   // bodies sideways. 2 (a half turn) cancels a constant bias; 4 also what changes with the
   // heading as cos θ or sin θ. Costs `turns` predictions; 1: off.
   int turns = 1;
+
+  // Throws ConfigError naming the field that is out of range.
+  void validate() const;
 };
 
 // Runs a FIGNet model: builds the graph, runs the network, un-normalises. One per thread.
