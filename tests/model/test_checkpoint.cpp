@@ -44,6 +44,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   trainer_config.seed = 7;
   trainer_config.adam.decay_steps = 20;
   trainer_config.rest_loss_weight = 30.0f;
+  trainer_config.still_air_fraction = 0.5f;
   Trainer uninterrupted(tiny_model(), trainer_config, data);
   uninterrupted.run(10, nullptr);
 
@@ -56,6 +57,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   EXPECT_EQ(checkpoint.trainer_config.batch_size, 2);
   EXPECT_EQ(checkpoint.trainer_config.adam.decay_steps, 20);
   EXPECT_EQ(checkpoint.trainer_config.rest_loss_weight, 30.0f);
+  EXPECT_EQ(checkpoint.trainer_config.still_air_fraction, 0.5f);
   Trainer resumed(checkpoint.model->config(), checkpoint.trainer_config, data,
                   checkpoint.model.get());
   resumed.restore(checkpoint.state);

@@ -232,6 +232,96 @@ TEST(Trainer, RestLossWeightScalesOnlyTheRestingBodiesShare) {
   EXPECT_NEAR(weighted - both, 4.0 * (both - flying), 1e-6 * weighted);
 }
 
+// Both cubes of a frame held still and let go: lifted together until the lower one's lowest
+// vertex is `gap` above the floor, their histories still (no noise) or a walk that the target
+// undoes (noise, correction 1), and every target row is gravity·dt².
+TEST(TrainingBatch, StillSampleInAirHoldsTheBodiesStillAboveTheFloorAndLetsThemFall) {
+  auto data = spinning_cubes(8);
+  data[0].floor = Floor{0.4};
+  const int history = ModelConfig::preset_named("small").graph.history, frame = 4;
+  const double gap = 0.03, dt = data[0].time_step;
+  const Vec3 fall = Vec3(0, 0, -10) * dt * dt;
+  Scene clean;
+  scene_at_frame(data[0], frame, history, clean);
+  // The clean frame's positions, lifted by one amount so that the lowest vertex sits at the gap.
+  double lowest = 1e9;
+  for (const SceneObject& object : clean.objects) {
+    lowest = std::min(lowest, object.positions_at(history).col(2).minCoeff());
+  }
+  const Vec3 lift(0, 0, 0.4 + gap - lowest);
+  for (NoiseKind kind : {NoiseKind::kVertex, NoiseKind::kRigid}) {
+    for (double noise_std : {0.0, 1e-2}) {
+      std::mt19937_64 rng(3);
+      Scene still;
+      Points targets;
+      make_still_sample_in_air(data[0], frame, history, gap, noise_std, kind, 1.0, rng, still,
+                               targets);
+      Eigen::Index row = 0;
+      for (size_t o = 0; o < still.objects.size(); ++o) {
+        const SceneObject& object = still.objects[o];
+        const Eigen::Index v = object.mesh->num_vertices();
+        const Points lifted = clean.objects[o].positions_at(history).rowwise() + lift.transpose();
+        const Points current = object.positions_at(history);
+        const Points next =
+            current + (current - object.positions_at(history - 1)) + targets.middleRows(row, v);
+        EXPECT_LT((next - (lifted.rowwise() + fall.transpose())).cwiseAbs().maxCoeff(), 1e-12);
+        if (noise_std == 0.0) {
+          for (int k = 0; k <= history; ++k) {
+            EXPECT_LT((object.positions_at(k) - lifted).cwiseAbs().maxCoeff(), 1e-12);
+          }
+          for (Eigen::Index i = 0; i < v; ++i) {
+            EXPECT_LT((targets.row(row + i) - fall.transpose()).norm(), 1e-15);
+          }
+        } else {
+          EXPECT_GT((current - lifted).cwiseAbs().maxCoeff(), 1e-4);  // the noise is there
+        }
+        row += v;
+      }
+    }
+  }
+}
+
+TEST(TrainingBatch, StillSampleInAirRejectsKinematicBodiesAndGapsThatAreNotPositive) {
+  auto data = spinning_cubes(8);
+  data[0].floor = Floor{};
+  std::mt19937_64 rng(3);
+  Scene scene;
+  Points targets;
+  auto make = [&](double gap) {
+    make_still_sample_in_air(data[0], 4, 2, gap, 0.0, NoiseKind::kVertex, 0.0, rng, scene, targets);
+  };
+  EXPECT_THROW(make(0.0), ConfigError);
+  EXPECT_THROW(make(std::nan("")), ConfigError);
+  EXPECT_TRUE(can_hold_still_in_air(data[0]));
+  data[0].objects[1].kinematic = true;
+  EXPECT_FALSE(can_hold_still_in_air(data[0]));
+  EXPECT_THROW(make(0.1), ConfigError);
+}
+
+// With every scene replaced, each node is a still body's and weighs the rest weight: the loss is
+// that weight times the unweighted one. Trajectories with kinematic bodies are never replaced.
+TEST(Trainer, StillAirSamplesReplaceTheirShareOfScenesAndWeighLikeRestingBodies) {
+  auto data = flying_and_resting_cubes(10);
+  data[0].floor = Floor{-1.0};
+  auto loss_with = [&](float fraction, float rest_weight, const std::vector<Trajectory>& d) {
+    TrainerConfig trainer_config;
+    trainer_config.still_air_fraction = fraction;
+    trainer_config.rest_loss_weight = rest_weight;
+    return untrained_loss(trainer_config, d);
+  };
+  const double plain = loss_with(0.0f, 1.0f, data), still = loss_with(1.0f, 1.0f, data);
+  EXPECT_NE(plain, still);
+  EXPECT_NEAR(loss_with(1.0f, 5.0f, data), 5.0 * still, 1e-6 * still);
+  const double half = loss_with(0.5f, 1.0f, data);
+  EXPECT_EQ(half, loss_with(0.5f, 1.0f, data));
+  auto with_pusher = data;
+  with_pusher[0].objects[0].kinematic = true;
+  EXPECT_EQ(loss_with(1.0f, 1.0f, with_pusher), loss_with(0.0f, 1.0f, with_pusher));
+  TrainerConfig bad;
+  bad.still_air_fraction = 1.5f;
+  EXPECT_THROW(Trainer(small_model(), bad, data), ConfigError);
+}
+
 TEST(Trainer, IsDeterministicForASeed) {
   const auto data = spinning_cubes(10);
   ModelConfig config = small_model();

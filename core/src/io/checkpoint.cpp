@@ -24,6 +24,7 @@ void write_training(H5::Group group, const TrainerConfig& config, const TrainerS
   write_attribute(group, "statistics_warmup", static_cast<long long>(config.statistics_warmup));
   write_attribute(group, "rest_loss_weight", double{config.rest_loss_weight});
   write_attribute(group, "weight_average", double{config.weight_average});
+  write_attribute(group, "still_air_fraction", double{config.still_air_fraction});
   write_attribute(group, "step", static_cast<long long>(state.step));
   write_attribute(group, "rng", state.rng);
   const hsize_t n = state.first_moment.size();
@@ -53,6 +54,8 @@ void read_training(const H5::Group& group, size_t parameters, const std::string&
     config.rest_loss_weight = static_cast<float>(read_double(group, "rest_loss_weight"));
   if (group.attrExists("weight_average"))
     config.weight_average = static_cast<float>(read_double(group, "weight_average"));
+  if (group.attrExists("still_air_fraction"))
+    config.still_air_fraction = static_cast<float>(read_double(group, "still_air_fraction"));
   state.step = read_integer(group, "step");
   state.rng = read_string(group, "rng");
   for (auto [name, out] : {std::pair("adam_first_moment", &state.first_moment),

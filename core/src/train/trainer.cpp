@@ -75,6 +75,10 @@ Trainer::Trainer(const ModelConfig& config, const TrainerConfig& trainer_config,
   }
   // The average starts at the starting parameters (restore() replaces it with a checkpoint's).
   if (trainer_config.weight_average > 0.0f) averaged_params_ = params_;
+  if (!(trainer_config.still_air_fraction >= 0.0f && trainer_config.still_air_fraction <= 1.0f)) {
+    throw ConfigError(fmt::format("trainer: still_air_fraction = {} (must be in [0, 1]; 0: none)",
+                                  trainer_config.still_air_fraction));
+  }
 }
 
 int Trainer::local_batch_size(int batch) const {
@@ -124,19 +128,42 @@ void Trainer::build_batch_graph(const std::vector<SampleRef>& batch, std::mt1993
   for (std::uint64_t& seed : scene_seeds_) seed = noise();
   auto make_samples = [&](int begin, int end) {
     for (int b = begin; b < end; ++b) {
+      const Trajectory& trajectory = data_[batch[b].trajectory];
       std::mt19937_64 rng(scene_seeds_[b]);
-      make_noisy_sample(data_[batch[b].trajectory], batch[b].frame, h, config_.noise_std,
-                        config_.noise, config_.noise_correction, rng, scenes_[b],
-                        scene_targets_[b]);
+      // Its own generator: runs without still bodies in the air draw the noise they always drew.
+      double gap = 0.0;
+      if (trainer_config_.still_air_fraction > 0.0f && can_hold_still_in_air(trajectory)) {
+        std::seed_seq still_seeds{static_cast<std::uint32_t>(scene_seeds_[b]),
+                                  static_cast<std::uint32_t>(scene_seeds_[b] >> 32),
+                                  std::uint32_t{0x57111}};
+        std::mt19937_64 still(still_seeds);
+        if (std::uniform_real_distribution<double>(0.0, 1.0)(still) <
+            trainer_config_.still_air_fraction) {
+          gap = std::exp(std::uniform_real_distribution<double>(std::log(kStillAirGaps[0]),
+                                                                std::log(kStillAirGaps[1]))(still));
+        }
+      }
+      if (gap > 0.0) {
+        make_still_sample_in_air(trajectory, batch[b].frame, h, gap, config_.noise_std,
+                                 config_.noise, config_.noise_correction, rng, scenes_[b],
+                                 scene_targets_[b]);
+      } else {
+        make_noisy_sample(trajectory, batch[b].frame, h, config_.noise_std, config_.noise,
+                          config_.noise_correction, rng, scenes_[b], scene_targets_[b]);
+      }
       // Drawn after the noise: a run without the turn draws the same noise as before it existed.
       if (config_.random_yaw) {
         std::uniform_real_distribution<double> angle(0.0, 2.0 * std::numbers::pi);
         turn_about_vertical(angle(rng), scenes_[b], scene_targets_[b]);
       }
       if (weighs_rest()) {
-        const Trajectory& trajectory = data_[batch[b].trajectory];
-        scene_resting_[b] =
-            resting_objects(trajectory, batch[b].frame, kRestSpeed * trajectory.time_step);
+        if (gap > 0.0) {
+          // Every dynamic body is still, in the air.
+          scene_resting_[b].assign(trajectory.objects.size(), 1);
+        } else {
+          scene_resting_[b] =
+              resting_objects(trajectory, batch[b].frame, kRestSpeed * trajectory.time_step);
+        }
       }
     }
   };

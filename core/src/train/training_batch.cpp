@@ -1,7 +1,12 @@
 #include "fignet/train/training_batch.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include "fignet/error.h"
 
 namespace fignet {
 
@@ -13,65 +18,127 @@ std::vector<SampleRef> enumerate_samples(const std::vector<Trajectory>& data, in
   return samples;
 }
 
-void make_noisy_sample(const Trajectory& trajectory, int frame, int history, double noise_std,
-                       NoiseKind kind, double position_correction, std::mt19937_64& rng,
-                       Scene& scene, Points& targets) {
-  scene_at_frame(trajectory, frame, history, scene);
+namespace {
+
+// Adds random-walk noise to the history of one dynamic object (see make_noisy_sample) and
+// returns the noise left on its current positions.
+Points add_history_noise(SceneObject& object, int history, double noise_std, NoiseKind kind,
+                         std::mt19937_64& rng) {
+  std::normal_distribution<double> normal(0.0, noise_std / std::sqrt(static_cast<double>(history)));
+  const Eigen::Index v = object.mesh->num_vertices();
+  // Random walk over the history steps: noise[k] = Σ_{j<=k} velocity noise, noise[0] = 0.
+  Points noise = Points::Zero(v, 3);
+  if (kind == NoiseKind::kVertex) {
+    for (int k = 1; k <= history; ++k) {
+      if (noise_std > 0.0) {
+        for (Eigen::Index i = 0; i < noise.size(); ++i) noise.data()[i] += normal(rng);
+      }
+      object.positions.middleRows(k * v, v) += noise;
+    }
+    return noise;
+  }
+  // The body's pose walks: a translation and a rotation about its centre, scaled so that its
+  // farthest vertex moves by about the translation's amount.
+  const double radius = std::max(object.mesh->vertices().rowwise().norm().maxCoeff(), 1e-3);
+  Vec3 translation = Vec3::Zero(), rotation = Vec3::Zero();
+  for (int k = 1; k <= history; ++k) {
+    if (noise_std > 0.0) {
+      for (int c = 0; c < 3; ++c) translation[c] += normal(rng);
+      for (int c = 0; c < 3; ++c) rotation[c] += normal(rng) / radius;
+    }
+    const Vec3 center = object.centers.row(k).transpose();
+    const Eigen::Matrix3d turn =
+        rotation.norm() > 0.0
+            ? Eigen::AngleAxisd(rotation.norm(), rotation.normalized()).toRotationMatrix()
+            : Eigen::Matrix3d::Identity();
+    auto step = object.positions.middleRows(k * v, v);
+    for (Eigen::Index i = 0; i < v; ++i) {
+      const Vec3 x = step.row(i).transpose();
+      const Vec3 moved = center + turn * (x - center) + translation;
+      noise.row(i) = (moved - x).transpose();
+      step.row(i) = moved.transpose();
+    }
+    object.centers.row(k) += translation.transpose();
+  }
+  return noise;
+}
+
+// Noise on every dynamic object's history, and its target rows from its clean next positions
+// (`clean_next(o)`): the velocity noise is undone, and the share `position_correction` of the
+// last position's noise too (the rest is kept).
+template <typename CleanNext>
+void add_noise_and_targets(Scene& scene, int history, double noise_std, NoiseKind kind,
+                           double position_correction, std::mt19937_64& rng,
+                           const CleanNext& clean_next, Points& targets) {
   Eigen::Index rows = 0;
   for (const SceneObject& object : scene.objects) rows += object.mesh->num_vertices();
   targets.setZero(rows, 3);
-  std::normal_distribution<double> normal(0.0, noise_std / std::sqrt(static_cast<double>(history)));
   Eigen::Index row = 0;
   for (size_t o = 0; o < scene.objects.size(); ++o) {
     SceneObject& object = scene.objects[o];
     const Eigen::Index v = object.mesh->num_vertices();
-    if (object.kinematic) {
-      row += v;
-      continue;
+    if (!object.kinematic) {
+      const Points noise = add_history_noise(object, history, noise_std, kind, rng);
+      targets.middleRows(row, v) = clean_next(o) - 2.0 * object.positions_at(history) +
+                                   object.positions_at(history - 1) +
+                                   (1.0 - position_correction) * noise;
     }
-    // Random walk over the history steps: noise[k] = Σ_{j<=k} velocity noise, noise[0] = 0.
-    Points noise = Points::Zero(v, 3);
-    if (kind == NoiseKind::kVertex) {
-      for (int k = 1; k <= history; ++k) {
-        if (noise_std > 0.0) {
-          for (Eigen::Index i = 0; i < noise.size(); ++i) noise.data()[i] += normal(rng);
-        }
-        object.positions.middleRows(k * v, v) += noise;
-      }
-    } else {
-      // The body's pose walks: a translation and a rotation about its centre, scaled so that its
-      // farthest vertex moves by about the translation's amount.
-      const double radius = std::max(object.mesh->vertices().rowwise().norm().maxCoeff(), 1e-3);
-      Vec3 translation = Vec3::Zero(), rotation = Vec3::Zero();
-      for (int k = 1; k <= history; ++k) {
-        if (noise_std > 0.0) {
-          for (int c = 0; c < 3; ++c) translation[c] += normal(rng);
-          for (int c = 0; c < 3; ++c) rotation[c] += normal(rng) / radius;
-        }
-        const Vec3 center = object.centers.row(k).transpose();
-        const Eigen::Matrix3d turn =
-            rotation.norm() > 0.0
-                ? Eigen::AngleAxisd(rotation.norm(), rotation.normalized()).toRotationMatrix()
-                : Eigen::Matrix3d::Identity();
-        auto step = object.positions.middleRows(k * v, v);
-        for (Eigen::Index i = 0; i < v; ++i) {
-          const Vec3 x = step.row(i).transpose();
-          const Vec3 moved = center + turn * (x - center) + translation;
-          noise.row(i) = (moved - x).transpose();
-          step.row(i) = moved.transpose();
-        }
-        object.centers.row(k) += translation.transpose();
-      }
-    }
-    // Target from the clean next frame: the velocity noise is undone, and the share
-    // `position_correction` of the last position's noise too (the rest is kept).
-    const Points next_positions =
-        posed_vertices(*object.mesh, trajectory.objects[o].poses[frame + 1]);
-    targets.middleRows(row, v) = next_positions - 2.0 * object.positions_at(history) +
-                                 object.positions_at(history - 1) +
-                                 (1.0 - position_correction) * noise;
     row += v;
   }
+}
+
+}  // namespace
+
+void make_noisy_sample(const Trajectory& trajectory, int frame, int history, double noise_std,
+                       NoiseKind kind, double position_correction, std::mt19937_64& rng,
+                       Scene& scene, Points& targets) {
+  scene_at_frame(trajectory, frame, history, scene);
+  add_noise_and_targets(
+      scene, history, noise_std, kind, position_correction, rng,
+      [&](size_t o) {
+        return posed_vertices(*scene.objects[o].mesh, trajectory.objects[o].poses[frame + 1]);
+      },
+      targets);
+}
+
+bool can_hold_still_in_air(const Trajectory& trajectory) {
+  return std::none_of(trajectory.objects.begin(), trajectory.objects.end(),
+                      [](const TrajectoryObject& object) { return object.kinematic; });
+}
+
+void make_still_sample_in_air(const Trajectory& trajectory, int frame, int history, double gap,
+                              double noise_std, NoiseKind kind, double position_correction,
+                              std::mt19937_64& rng, Scene& scene, Points& targets) {
+  if (!can_hold_still_in_air(trajectory)) {
+    throw ConfigError(
+        "make_still_sample_in_air: the trajectory has kinematic objects, whose "
+        "motion could meet the lifted bodies");
+  }
+  if (!(gap > 0.0) || !std::isfinite(gap)) {
+    throw ConfigError(fmt::format("make_still_sample_in_air: gap = {} (must be > 0)", gap));
+  }
+  scene_at_frame(trajectory, frame, history, scene);
+  // One lift for all the bodies keeps them as they lie on each other.
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const SceneObject& object : scene.objects) {
+    lowest = std::min(lowest, object.positions_at(history).col(2).minCoeff());
+  }
+  const double lift = scene.floor ? scene.floor->height + gap - lowest : 0.0;
+  std::vector<Pose> lifted(scene.objects.size());
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    lifted[o] = trajectory.objects[o].poses[frame];
+    lifted[o].position.z() += lift;
+    const std::vector<Pose> still(static_cast<size_t>(history) + 1, lifted[o]);
+    set_pose_history(scene.objects[o], still);
+  }
+  // Nothing holds them: each vertex falls by gravity·dt² over the step, as in free flight.
+  const Vec3 fall = trajectory.gravity * trajectory.time_step * trajectory.time_step;
+  add_noise_and_targets(
+      scene, history, noise_std, kind, position_correction, rng,
+      [&](size_t o) -> Points {
+        return posed_vertices(*scene.objects[o].mesh, lifted[o]).rowwise() + fall.transpose();
+      },
+      targets);
 }
 
 void turn_about_vertical(double angle, Scene& scene, Points& targets) {

@@ -117,6 +117,8 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.huber_delta; })},
       {"rest_loss_weight",
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.rest_loss_weight; })},
+      {"still_air_fraction",
+       plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.still_air_fraction; })},
       {"weight_average",
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.weight_average; })},
       {"statistics_warmup",
@@ -289,6 +291,12 @@ void TrainingConfig::validate() const {
     throw ConfigError(
         fmt::format("rest_loss_weight = {} (must be >= 0; 1: resting bodies count like the others)",
                     trainer.rest_loss_weight));
+  }
+  if (!(trainer.still_air_fraction >= 0.0f && trainer.still_air_fraction <= 1.0f)) {
+    throw ConfigError(fmt::format(
+        "still_air_fraction = {} (must be in [0, 1]: the share of samples whose bodies are held "
+        "still in the air and let go; 0: none)",
+        trainer.still_air_fraction));
   }
   if (!(trainer.weight_average >= 0.0f && trainer.weight_average < 1.0f)) {
     throw ConfigError(fmt::format(

@@ -39,6 +39,12 @@ struct TrainerConfig {
   // Their targets are ~1e-3σ, so a bias that integrates to metres over a long rest costs the
   // unweighted loss almost nothing.
   float rest_loss_weight = 1.0f;
+  // Share of the scenes replaced by their bodies held still in the air and let go
+  // (make_still_sample_in_air), the gap under them drawn log-uniformly from kStillAirGaps (0:
+  // none; trajectories with kinematic objects are never replaced). Their nodes weigh
+  // rest_loss_weight like resting bodies': the two kinds of still body, told apart only by
+  // what lies under them. A rest weight alone teaches that still bodies stay still in the air too.
+  float still_air_fraction = 0.0f;
   // Decay of an exponential moving average of the parameters, updated after every step (0: none;
   // 0.999 averages over ~1000 steps). When on, the average is the model the run produces
   // (model(), validation, the --out file): it smooths the step-to-step noise that makes

@@ -30,6 +30,25 @@ void make_noisy_sample(const Trajectory& trajectory, int frame, int history, dou
                        NoiseKind kind, double position_correction, std::mt19937_64& rng,
                        Scene& scene, Points& targets);
 
+// Whether make_still_sample_in_air can use the trajectory: it has no kinematic objects (a pusher's
+// motion could meet the lifted bodies, and the target would not be gravity alone).
+bool can_hold_still_in_air(const Trajectory& trajectory);
+
+// The gaps the trainer draws for still bodies in the air (log-uniform, metres): from just more
+// than a body let go falls in one 48 Hz step (g·dt² = 4.3 mm) to far above the collision radius.
+inline constexpr double kStillAirGaps[2] = {0.005, 2.0};
+
+// A sample no trajectory holds: every body of the frame held still in the air and let go. Every
+// dynamic body's history is its pose at `frame`, all lifted together so that the lowest vertex
+// is `gap` metres above the floor (not lifted without a floor); the target is gravity·dt² for
+// every vertex, as in free flight. Noise and its correction as in make_noisy_sample. MOVi throws
+// its bodies, so nearly every still body in the data lies on something, and a model trained on
+// it alone learns that still bodies stay still, in the air too. Throws ConfigError for a
+// trajectory can_hold_still_in_air rejects or a gap that is not > 0.
+void make_still_sample_in_air(const Trajectory& trajectory, int frame, int history, double gap,
+                              double noise_std, NoiseKind kind, double position_correction,
+                              std::mt19937_64& rng, Scene& scene, Points& targets);
+
 // Turns a sample, its scene (see turn_about_vertical(double, Scene&)) and its target rows, by
 // `angle` radians about the vertical axis through the floor's centre.
 void turn_about_vertical(double angle, Scene& scene, Points& targets);
