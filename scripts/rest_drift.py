@@ -13,7 +13,8 @@ motion (native Bullet creeps ~7 µm per frame there by itself).
 --trace prints the first body's displacement and velocity along the run instead (how it is lost:
 a drift that grows as t², or one that stops); --slide the friction the model applies in one step
 to a body pushed along the floor (the part of the change of speed that reverses with the push)
-against Coulomb's, and its bias (the change with no push).
+against Coulomb's, and its bias (the change with no push); --release the same bodies let go from
+rest above their rest poses (a model trained on thrown bodies may hold a still body in the air).
 """
 
 import argparse
@@ -41,14 +42,15 @@ FLOOR_FRICTION = 0.3  # MOVi's floor (reference/facts.md); Bullet multiplies the
 TURNS = 1  # --turns
 
 
-def alone_at_rest(model, t, o, velocity=(0.0, 0.0, 0.0)):
-    """A scene of the body alone at its recorded rest pose (sliding at `velocity`, m/s), stepped
-    by the network alone."""
+def alone_at_rest(model, t, o, velocity=(0.0, 0.0, 0.0), lift=0.0):
+    """A scene of the body alone at its recorded rest pose (sliding at `velocity`, m/s; `lift`
+    metres higher), stepped by the network alone."""
     scene = fignet.Scene(model, free_flight=False, sleeping=False, penetration_guard=False,
                          rest_guard=False, turns=TURNS)
     scene.add_floor(height=t.floor_height, friction=FLOOR_FRICTION)
     scene.add_body(t.vertices(o), t.faces(o), mass=t.masses[o], friction=t.frictions[o],
-                   restitution=t.restitutions[o], position=t.positions[-1, o],
+                   restitution=t.restitutions[o],
+                   position=t.positions[-1, o] + np.array([0.0, 0.0, lift]),
                    orientation=t.quaternions[-1, o], linear_velocity=velocity)
     return scene
 
@@ -114,6 +116,30 @@ def slide(models, bodies, speeds):
               + " | ".join(f"{c:+.3f}" for c in changes) + " |")
 
 
+def release(models, bodies, gaps):
+    """Each body let go from rest `gap` metres above its rest pose: how far it falls over the
+    steps exact free fall takes to come within 1 mm of the floor, as a share of that fall (1:
+    like free flight, 0: held in the air), median and least over bodies. With a still history
+    and gravity g·dt² per step, free fall covers g·dt²·n(n+1)/2 in n steps."""
+    g_dt2 = 10.0 * bodies[0][0].time_step ** 2
+    steps = [max(1, int((np.sqrt(1 + 8 * (gap - 1e-3) / g_dt2) - 1) / 2)) for gap in gaps]
+    print("| model | " + " | ".join(f"{gap} m ({n} steps)" for gap, n in zip(gaps, steps)) + " |")
+    print("|---|" + "---|" * len(gaps))
+    for path in models:
+        model = fignet.load_model(path)
+        cells = []
+        for gap, n in zip(gaps, steps):
+            free_fall = g_dt2 * n * (n + 1) / 2
+            shares = []
+            for t, o in bodies:
+                scene = alone_at_rest(model, t, o, lift=gap)
+                start = scene.positions[0][2]
+                scene.step(n)
+                shares.append((start - scene.positions[0][2]) / free_fall)
+            cells.append(f"{np.median(shares):.2f} / {np.min(shares):.2f}")
+        print(f"| {path.name} | " + " | ".join(cells) + " |")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", type=pathlib.Path, action="append", required=True)
@@ -125,6 +151,10 @@ def main():
     parser.add_argument("--slide", action="store_true",
                         help="print the friction the model applies in one step to pushed bodies, "
                              "and its bias at rest, instead")
+    parser.add_argument("--release", type=float, nargs="*", metavar="GAP",
+                        help="let each body go from rest GAP metres above its rest pose "
+                             "(default gaps 2, 0.5, 0.1, 0.03, 0.01) and print how far it falls "
+                             "as a share of free fall, instead")
     parser.add_argument("--turns", type=int, default=1,
                         help="average each prediction over the scene turned by k/turns of a turn "
                              "about the vertical (1: off)")
@@ -141,6 +171,13 @@ def main():
               "the part of the change of speed in the first step that reverses with the push "
               "(friction), and the change with no push (bias), m/s, mean\n")
         slide(args.model, bodies, [0.01, 0.03, 0.1, 0.3, 1.0, 3.0])
+        return
+    if args.release is not None:
+        gaps = args.release or [2.0, 0.5, 0.1, 0.03, 0.01]
+        print(f"{len(bodies)} bodies of {args.data.name} let go from rest above their rest poses: "
+              "fall over the steps exact free fall takes to come within 1 mm of the floor, as a "
+              "share of that fall, median / least (1: falls freely; 0: held in the air)\n")
+        release(args.model, bodies, gaps)
         return
     if args.trace:
         t, o = bodies[0]
