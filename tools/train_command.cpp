@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -23,6 +22,7 @@
 #include "fignet/train/training_config.h"
 #include "process_group.h"
 #include "progress.h"
+#include "stop_signals.h"
 #include "training_log.h"
 
 namespace fignet::cli {
@@ -43,11 +43,6 @@ struct TrainArgs {
   int valid_trajectories = 10, threads = 0;
   DeviceArgs device;
 };
-
-volatile std::sig_atomic_t stop_requested = 0;
-extern "C" void request_stop(int) {
-  stop_requested = 1;
-}
 
 // The run's config: preset, then the JSON file, then --set overrides, then --steps.
 // decay_steps follows the run's length unless set.
@@ -123,6 +118,8 @@ void apply_resume_settings(const std::vector<std::string>& settings, TrainingCon
 }
 
 void run_train(const TrainArgs& args) {
+  // Before any thread of OpenMP starts: those threads inherit the blocked signals.
+  StopSignals stop_signals;
   if (args.threads > 0) omp_set_num_threads(args.threads);
   const fs::path checkpoint_path =
       args.checkpoint.empty() ? fs::path(args.out.string() + ".ckpt.h5") : args.checkpoint;
@@ -205,9 +202,6 @@ void run_train(const TrainArgs& args) {
   if (root)
     log.emplace(log_path, trainer.steps_done(), resumed_batch_size, config.trainer.batch_size);
 
-  stop_requested = 0;
-  std::signal(SIGINT, request_stop);
-  std::signal(SIGTERM, request_stop);
   auto save = [&] {
     if (!root) return;  // every process holds the same model and optimizer state
     save_checkpoint(trainer, checkpoint_path, config.steps);
@@ -215,7 +209,7 @@ void run_train(const TrainArgs& args) {
   };
   // Processes stop together, at the same step, or the others would wait in a sum forever.
   auto stop_agreed = [&] {
-    double stop = stop_requested ? 1.0 : 0.0;
+    double stop = stop_signals.requested() ? 1.0 : 0.0;
     if (group.size() > 1) group.collective->sum(std::span<double>(&stop, 1));
     return stop > 0.0;
   };
@@ -271,8 +265,6 @@ void run_train(const TrainArgs& args) {
     }
   }
   save();
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
   if (!root) return;
   bar.finish(trainer.steps_done());
   const TrainerTimes& times = trainer.times();

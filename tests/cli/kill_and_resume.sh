@@ -1,7 +1,9 @@
 #!/bin/sh
 # kill -9 in the middle of `fignet generate` and `fignet train`: the output is either absent or
 # whole (written to a temporary file, then renamed), a rerun works, and training resumes from
-# its last checkpoint.
+# its last checkpoint. SIGTERM in the middle of training steps: the run stops cleanly (exit 0, a
+# checkpoint it names), three times (a handler that ran mid-step used to corrupt the heap now
+# and then).
 #   kill_and_resume.sh FIGNET WORKDIR
 set -eu
 fignet="$1"
@@ -38,4 +40,23 @@ step=$("$fignet" train --data "$work/set.h5" --threads 1 --resume --steps 0 \
 [ -n "$step" ] || { echo "the checkpoint left by the killed run does not load"; exit 1; }
 "$fignet" train --data "$work/set.h5" --threads 1 --resume --steps $((step + 2)) \
     --out "$work/model.h5" 2>/dev/null | grep "trained $((step + 2)) steps"
+
+# train: SIGTERM mid-step, three times at different moments of the steps.
+for delay in 0.3 0.7 1.1; do
+  rm -f "$work"/stopped.h5*
+  "$fignet" train --data "$work/set.h5" --preset small --set batch_size=4 \
+      --set statistics_warmup=0 --threads 1 --steps 100000 --log-every 1 \
+      --out "$work/stopped.h5" >"$work/stopped.out" 2>&1 &
+  pid=$!
+  # Steps are under way once the log has its first line.
+  while [ ! -s "$work/stopped.h5.log.jsonl" ]; do sleep 0.1; done
+  sleep "$delay"
+  kill -TERM "$pid"
+  status=0
+  wait "$pid" || status=$?
+  [ "$status" -eq 0 ] || { echo "SIGTERM after $delay s: exit status $status"; cat "$work/stopped.out"; exit 1; }
+  grep -q "^stopped at step [0-9]*; checkpoint" "$work/stopped.out" ||
+    { echo "SIGTERM after $delay s: no stop line"; cat "$work/stopped.out"; exit 1; }
+done
+echo "train stopped by SIGTERM three times: ok"
 echo "train killed at step $step or later, resumed: ok"
