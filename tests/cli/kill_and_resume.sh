@@ -30,7 +30,7 @@ echo "generate rerun: ok"
     --threads 1 --steps 100000 \
     --checkpoint-minutes 0 --out "$work/model.h5" >/dev/null 2>&1 &
 pid=$!
-while [ ! -e "$work/model.h5.ckpt.h5" ]; do sleep 0.2; done
+while [ ! -e "$work/model.h5.ckpt.h5" ] && kill -0 "$pid" 2>/dev/null; do sleep 0.2; done
 sleep 1
 kill -9 "$pid"
 wait "$pid" 2>/dev/null || true
@@ -49,7 +49,7 @@ for delay in 0.3 0.7 1.1; do
       --out "$work/stopped.h5" >"$work/stopped.out" 2>&1 &
   pid=$!
   # Steps are under way once the log has its first line.
-  while [ ! -s "$work/stopped.h5.log.jsonl" ]; do sleep 0.1; done
+  while [ ! -s "$work/stopped.h5.log.jsonl" ] && kill -0 "$pid" 2>/dev/null; do sleep 0.1; done
   sleep "$delay"
   kill -TERM "$pid"
   status=0
