@@ -7,6 +7,7 @@
 #include "fignet/geometry/mass_properties.h"
 #include "fignet/geometry/shapes.h"
 #include "fignet/graph/contacts.h"
+#include "fignet/train/training_batch.h"
 
 namespace fignet::bullet {
 namespace {
@@ -105,6 +106,31 @@ TEST(Generator, ScenesStartWithoutOverlapAndStayAboveTheFloor) {
       }
     }
   }
+}
+
+// Still bodies in the air (the trainer's still_air_fraction) are taught to fall freely, so they
+// must start clear of where resting bodies lie: bodies at rest on the floor in generated data have
+// their lowest vertex at Bullet's collision margin, at least two steps of free fall below the
+// smallest still-air gap.
+TEST(Generator, BodiesRestingOnTheFloorLieBelowTheSmallestStillAirGap) {
+  GenerateOptions options = small_options(2);
+  options.count = 10;
+  options.scene.frames = 192;  // long enough for most bodies to come to rest
+  int resting = 0;
+  for (const Trajectory& t : generate_dataset(options)) {
+    const double fall = t.gravity.norm() * t.time_step * t.time_step;
+    for (const auto& object : t.objects) {
+      const Pose& last = object.poses.back();
+      const Pose& earlier = object.poses[object.poses.size() - 10];
+      if ((last.position - earlier.position).cwiseAbs().maxCoeff() > 1e-4) continue;
+      const double lowest = posed_vertices(*object.mesh, last).col(2).minCoeff() - t.floor->height;
+      if (lowest > 0.05) continue;  // resting on another body
+      ++resting;
+      EXPECT_NEAR(lowest, SceneSpec{}.collision_margin, 1e-3) << "seed " << t.seed;
+      EXPECT_LE(lowest, kStillAirGaps[0] - 2 * fall) << "seed " << t.seed;
+    }
+  }
+  EXPECT_GE(resting, 3);
 }
 
 TEST(Generator, PusherFollowsItsScriptedPathExactly) {

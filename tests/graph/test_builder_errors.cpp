@@ -61,6 +61,14 @@ TEST(GraphBuilderErrors, BadConfigValues) {
   config = {};
   config.floor_half_extent = NAN;
   EXPECT_THROW(GraphBuilder{config}, ConfigError);
+  config = {};
+  config.distance_log_scale = -1e-3;
+  try {
+    GraphBuilder{config};
+    FAIL();
+  } catch (const ConfigError& e) {
+    expect_contains(e.what(), "distance_log_scale = -0.001");
+  }
 }
 
 TEST(GraphBuilderErrors, CandidatePairOutOfRange) {

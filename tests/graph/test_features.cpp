@@ -188,6 +188,27 @@ TEST_F(TwoTetrahedra, SpanLimitShortensOnlyTheLongSpans) {
   EXPECT_GE(shortened, 3);
 }
 
+// distance_log_scale s appends ln(1 + |d_rs|/s) to each face–face row; the 34 columns before it
+// are the plain ones.
+TEST_F(TwoTetrahedra, DistanceLogarithmFollowsTheFaceEdgeRow) {
+  GraphConfig config;
+  config.distance_log_scale = 0.001;
+  Graph graph;
+  GraphBuilder(config).build(scene_, graph);
+  ASSERT_EQ(graph.face_edges.features.cols(), 35);
+  ASSERT_EQ(graph.face_edges.size(), graph_.face_edges.size());
+  EXPECT_EQ(graph.face_edges.senders, graph_.face_edges.senders);
+  for (int e = 0; e < graph_.face_edges.size(); ++e) {
+    const float* plain = graph_.face_edges.features.row(e);
+    std::vector<double> expected(plain, plain + 34);
+    expected.push_back(std::log1p(plain[3] / 0.001));
+    expect_row(graph.face_edges.features.row(e), expected);
+  }
+  // All three pairs meet at B's apex, 0.05 m below A's bottom face: ln(1 + 50).
+  for (int e = 0; e < graph.face_edges.size(); ++e)
+    EXPECT_NEAR(graph.face_edges.features.row(e)[34], std::log(51.0), 1e-5) << "edge " << e;
+}
+
 TEST_F(TwoTetrahedra, ReverseEdgeSwapsRoles) {
   // Every face edge has a twin with senders and receivers exchanged and d_rs negated.
   for (int e = 0; e < graph_.face_edges.size(); e += 2) {

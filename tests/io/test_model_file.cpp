@@ -25,6 +25,7 @@ class ModelFile : public testing::TempFolderTest {
     config.random_yaw = true;
     config.graph.face_span_limit = 0.75;
     config.graph.velocity_log_scale = 1e-4;
+    config.graph.distance_log_scale = 2e-3;
     Model fresh(config);
     Normalizers normalizers = fresh.normalizers();
     RowMatrixXf rows = RowMatrixXf::Random(10, normalizers.mesh_node.size());
@@ -63,6 +64,8 @@ TEST_F(ModelFile, SaveThenLoadIsBitExact) {
   EXPECT_TRUE(loaded.config().random_yaw);
   EXPECT_EQ(loaded.config().graph.face_span_limit, 0.75);
   EXPECT_EQ(loaded.config().graph.velocity_log_scale, 1e-4);
+  EXPECT_EQ(loaded.config().graph.distance_log_scale, 2e-3);
+  EXPECT_EQ(loaded.normalizers().face_edge.size(), 35);
   EXPECT_EQ(loaded.normalizers().mesh_node.sum(), model_->normalizers().mesh_node.sum());
   EXPECT_EQ(loaded.normalizers().mesh_node.sum_squares(),
             model_->normalizers().mesh_node.sum_squares());

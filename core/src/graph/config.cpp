@@ -25,6 +25,9 @@ void GraphConfig::validate() const {
   if (!(velocity_log_scale >= 0.0) || !std::isfinite(velocity_log_scale)) {
     fail("velocity_log_scale", velocity_log_scale, "must be >= 0 metres per frame (0: off)");
   }
+  if (!(distance_log_scale >= 0.0) || !std::isfinite(distance_log_scale)) {
+    fail("distance_log_scale", distance_log_scale, "must be >= 0 metres (0: off)");
+  }
   if (!(face_span_limit >= 0.0) || !std::isfinite(face_span_limit)) {
     fail("face_span_limit", face_span_limit, "must be >= 0 metres (0: no limit)");
   }
@@ -41,7 +44,7 @@ FeatureSizes feature_sizes(const GraphConfig& config) {
       .object_node = dynamic_part,
       .mesh_edge = 8,
       .world_edge = 4,
-      .face_edge = 34,
+      .face_edge = 34 + (config.distance_log_scale > 0.0 ? 1 : 0),
   };
 }
 

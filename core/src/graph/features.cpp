@@ -158,17 +158,23 @@ Vec3 current_normal(const PosedMesh& posed, int face) {
                          vertices.row(f(2)).transpose());
 }
 
-// [d_rs, |d_rs|, (d_sj, |d_sj|)_j, (d_rj, |d_rj|)_j, n_r, n_s] (seed C.1.1).
-void put_face_edge(const PosedMesh& sender, int sender_face, const Vec3& p_s, int sender_first,
-                   const PosedMesh& receiver, int receiver_face, const Vec3& p_r,
-                   int receiver_first, double span_limit, FaceEdgeSet& out) {
-  const SortedFace s = sort_face(sender, sender_face, p_s, span_limit);
-  const SortedFace r = sort_face(receiver, receiver_face, p_r, span_limit);
-  float* row = put_vector(out.features.append_rows(1), p_r - p_s);
+// [d_rs, |d_rs|, (d_sj, |d_sj|)_j, (d_rj, |d_rj|)_j, n_r, n_s] (seed C.1.1), then
+// ln(1 + |d_rs|/s) when distance_log_scale s > 0.
+void put_face_edge(const GraphConfig& config, const PosedMesh& sender, int sender_face,
+                   const Vec3& p_s, int sender_first, const PosedMesh& receiver, int receiver_face,
+                   const Vec3& p_r, int receiver_first, FaceEdgeSet& out) {
+  const SortedFace s = sort_face(sender, sender_face, p_s, config.face_span_limit);
+  const SortedFace r = sort_face(receiver, receiver_face, p_r, config.face_span_limit);
+  const Vec3 d = p_r - p_s;
+  float* row = put_vector(out.features.append_rows(1), d);
   for (const Vec3& span : s.spans) row = put_vector(row, span);
   for (const Vec3& span : r.spans) row = put_vector(row, span);
   row = put_direction(row, current_normal(receiver, receiver_face));
-  put_direction(row, current_normal(sender, sender_face));
+  row = put_direction(row, current_normal(sender, sender_face));
+  // Resting contact (|d| ≈ 0) and a body let go millimetres above it are ~0.05σ apart in |d|
+  // above; on a logarithmic scale they are a unit or more apart.
+  if (const double scale = config.distance_log_scale; scale > 0.0)
+    *row = static_cast<float>(std::log1p(d.norm() / scale));
   for (int k = 0; k < 3; ++k) {
     out.senders.push_back(sender_first + s.nodes[k]);
     out.receivers.push_back(receiver_first + r.nodes[k]);
@@ -177,12 +183,12 @@ void put_face_edge(const PosedMesh& sender, int sender_face, const Vec3& p_s, in
 
 }  // namespace
 
-void append_face_edges(const FacePair& pair, const PosedMesh& a, const PosedMesh& b, int first_a,
-                       int first_b, double span_limit, FaceEdgeSet& out) {
-  put_face_edge(a, pair.face_a, pair.point_a, first_a, b, pair.face_b, pair.point_b, first_b,
-                span_limit, out);
-  put_face_edge(b, pair.face_b, pair.point_b, first_b, a, pair.face_a, pair.point_a, first_a,
-                span_limit, out);
+void append_face_edges(const GraphConfig& config, const FacePair& pair, const PosedMesh& a,
+                       const PosedMesh& b, int first_a, int first_b, FaceEdgeSet& out) {
+  put_face_edge(config, a, pair.face_a, pair.point_a, first_a, b, pair.face_b, pair.point_b,
+                first_b, out);
+  put_face_edge(config, b, pair.face_b, pair.point_b, first_b, a, pair.face_a, pair.point_a,
+                first_a, out);
 }
 
 void append_world_edges(const NodePair& pair, const PosedMesh& a, const PosedMesh& b, int first_a,

@@ -18,9 +18,9 @@ void append_mesh_edges(const SceneObject& object, int first, EdgeSet& out);
 void append_object_mesh_edges(const SceneObject& object, int object_index, int first,
                               EdgeSet& object_to_mesh, EdgeSet& mesh_to_object);
 // Both directions of a face pair; first_a/first_b are the objects' first global node indices.
-// span_limit > 0 shortens the spans (closest point to face vertex) to at most that length.
-void append_face_edges(const FacePair& pair, const PosedMesh& a, const PosedMesh& b, int first_a,
-                       int first_b, double span_limit, FaceEdgeSet& out);
+// config's face_span_limit and distance_log_scale shape the rows.
+void append_face_edges(const GraphConfig& config, const FacePair& pair, const PosedMesh& a,
+                       const PosedMesh& b, int first_a, int first_b, FaceEdgeSet& out);
 void append_world_edges(const NodePair& pair, const PosedMesh& a, const PosedMesh& b, int first_a,
                         int first_b, EdgeSet& out);
 

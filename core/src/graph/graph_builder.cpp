@@ -230,9 +230,9 @@ void GraphBuilder::build_scenes(std::span<const Scene> scenes,
     if (face_collisions) {
       contacts_.find_face_pairs(pairs_, config_.collision_radius, scene_face_pairs_);
       for (FacePair pair : scene_face_pairs_) {
-        detail::append_face_edges(pair, posed_[pair.object_a], posed_[pair.object_b],
+        detail::append_face_edges(config_, pair, posed_[pair.object_a], posed_[pair.object_b],
                                   first_node(pair.object_a), first_node(pair.object_b),
-                                  config_.face_span_limit, graph.face_edges);
+                                  graph.face_edges);
         pair.object_a += first_object;
         pair.object_b += first_object;
         face_pairs_.push_back(pair);

@@ -58,6 +58,7 @@ void write_config(H5::Group group, const ModelConfig& c) {
   write_attribute(group, "log_mass", static_cast<long long>(c.graph.log_mass));
   write_attribute(group, "face_span_limit", c.graph.face_span_limit);
   write_attribute(group, "velocity_log_scale", c.graph.velocity_log_scale);
+  write_attribute(group, "distance_log_scale", c.graph.distance_log_scale);
   write_attribute(group, "noise", std::string(c.noise == NoiseKind::kRigid ? "rigid" : "vertex"));
   write_attribute(group, "noise_correction", c.noise_correction);
   write_attribute(group, "random_yaw", static_cast<long long>(c.random_yaw));
@@ -109,6 +110,9 @@ ModelConfig read_config(const H5::Group& group) {
   }
   if (group.attrExists("velocity_log_scale")) {
     c.graph.velocity_log_scale = read_double(group, "velocity_log_scale");
+  }
+  if (group.attrExists("distance_log_scale")) {
+    c.graph.distance_log_scale = read_double(group, "distance_log_scale");
   }
   if (group.attrExists("noise")) {
     const std::string noise = read_string(group, "noise");

@@ -39,6 +39,10 @@ struct GraphConfig {
   // > 0: node features also carry sign(v)·ln(1 + |v|/s) of each velocity component, s in metres
   // per frame, so that sub-millimetre motion (a body sliding to a stop) is not ~0.01σ.
   double velocity_log_scale = 0.0;
+  // > 0: face–face edges also carry ln(1 + |d_rs|/s) of the closest-point distance, s in metres.
+  // |d_rs| is normalised by a spread set by the collision radius (~5 cm), where a body resting on
+  // the floor and one held a few millimetres above it differ by ~0.05σ.
+  double distance_log_scale = 0.0;
 
   // Throws ConfigError naming the first invalid field and its value.
   void validate() const;
@@ -52,6 +56,7 @@ struct FeatureSizes {
   int mesh_edge;    // [d, |d|, d_rest, |d_rest|] = 8; also object->mesh and mesh->object
   int world_edge;   // [d, |d|] = 4 (node–node collision edges)
   int face_edge;    // [d_rs, 3 sender spans, 3 receiver spans] with norms, n_r, n_s = 34
+                    // (+ 1 logarithm of |d_rs|)
 };
 FeatureSizes feature_sizes(const GraphConfig& config);
 
