@@ -171,8 +171,8 @@ void put_face_edge(const GraphConfig& config, const PosedMesh& sender, int sende
   for (const Vec3& span : r.spans) row = put_vector(row, span);
   row = put_direction(row, current_normal(receiver, receiver_face));
   row = put_direction(row, current_normal(sender, sender_face));
-  // Resting contact (|d| ≈ 0) and a body let go millimetres above it are ~0.05σ apart in |d|
-  // above; on a logarithmic scale they are a unit or more apart.
+  // Resting contact (|d| = 5 mm, Bullet's margin) and a body let go a few millimetres higher are
+  // ~0.1σ apart in |d| above (σ ≈ 3 cm); on a logarithmic scale they are ~0.5 apart.
   if (const double scale = config.distance_log_scale; scale > 0.0)
     *row = static_cast<float>(std::log1p(d.norm() / scale));
   for (int k = 0; k < 3; ++k) {
