@@ -119,11 +119,14 @@ TEST(Generator, BodiesRestingOnTheFloorLieBelowTheSmallestStillAirGap) {
   int resting = 0;
   for (const Trajectory& t : generate_dataset(options)) {
     const double fall = t.gravity.norm() * t.time_step * t.time_step;
-    for (const auto& object : t.objects) {
-      const Pose& last = object.poses.back();
-      const Pose& earlier = object.poses[object.poses.size() - 10];
-      if ((last.position - earlier.position).cwiseAbs().maxCoeff() > 1e-4) continue;
-      const double lowest = posed_vertices(*object.mesh, last).col(2).minCoeff() - t.floor->height;
+    // The bodies the trainer weighs as resting (rest_loss_weight), at the second-last frame.
+    const int frame = t.num_frames() - 2;
+    const auto at_rest = resting_objects(t, frame, kRestSpeed * t.time_step);
+    for (size_t o = 0; o < t.objects.size(); ++o) {
+      if (!at_rest[o]) continue;
+      const TrajectoryObject& object = t.objects[o];
+      const double lowest =
+          posed_vertices(*object.mesh, object.poses[frame]).col(2).minCoeff() - t.floor->height;
       if (lowest > 0.05) continue;  // resting on another body
       ++resting;
       EXPECT_NEAR(lowest, SceneSpec{}.collision_margin, 1e-3) << "seed " << t.seed;
