@@ -1,17 +1,77 @@
 #!/usr/bin/env python3
 """The validations of `fignet train` logs (OUT.log.jsonl) as one Markdown table.
 
-Usage: scripts/training-log.py [--batch NAME=B ...] LOG [LOG ...]
+Usage: scripts/training-log.py [--batch NAME=B ...] [--fit] [--fit-from SAMPLES] [--plot PNG]
+                               LOG [LOG ...]
 
 One row per validation of each log: steps, samples seen (the log's "samples"; logs from before
 that field need --batch, and count steps × batch), the rollouts' mean translation and rotation error,
 and the one-step error per regime (free flight, moving contact, rest) in millimetres. The runs of
 a compute-matched comparison are best read side by side at equal samples.
+
+--fit adds, per log, the learning curve as a power law: a least-squares line through
+ln(translation) against ln(samples) over the validations from --fit-from samples on, its slope
+with the slope's standard error, and where the line reaches at 10x and 100x the last validation's
+samples (with the range the slope's standard error gives). Successive validations of one run
+scatter by 10-30 %, so the fit says how the curve trends, not what a longer run will measure.
+--plot writes the curves and their fits on log-log axes (needs matplotlib).
 """
 import argparse
 import json
+import math
 import pathlib
 import sys
+
+
+def parse_count(text: str) -> float:
+    """A sample count: 250000, 250k or 1.2M."""
+    scale = {"k": 1e3, "m": 1e6}.get(text[-1:].lower(), 1.0)
+    number = text[:-1] if scale != 1.0 else text
+    try:
+        value = float(number) * scale
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a sample count (e.g. 100000, 100k, 1.2M)")
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"'{text}': a sample count is not negative")
+    return value
+
+
+def power_law_fit(samples, errors):
+    """Least squares of ln(error) = intercept + slope·ln(samples).
+
+    Returns (intercept, slope, slope's standard error; None with fewer than 3 points)."""
+    xs = [math.log(s) for s in samples]
+    ys = [math.log(e) for e in errors]
+    n = len(xs)
+    mean_x, mean_y = sum(xs) / n, sum(ys) / n
+    sxx = sum((x - mean_x) ** 2 for x in xs)
+    if sxx == 0:
+        raise ValueError("every validation is at the same sample count")
+    slope = sum((x - mean_x) * (y - mean_y) for x, y in zip(xs, ys)) / sxx
+    intercept = mean_y - slope * mean_x
+    if n < 3:
+        return intercept, slope, None
+    residuals = sum((y - intercept - slope * x) ** 2 for x, y in zip(xs, ys))
+    return intercept, slope, math.sqrt(residuals / (n - 2) / sxx)
+
+
+def read_validations(log: pathlib.Path, batch):
+    """The log's validations as dicts with 'samples' filled in (None when unknown)."""
+    validations = []
+    for number, line in enumerate(log.read_text().splitlines(), 1):
+        try:
+            entry = json.loads(line)
+        except json.JSONDecodeError:
+            raise ValueError(f"{log}:{number}: not a JSON line")
+        if "valid_translation_m" not in entry:
+            continue
+        entry.setdefault("samples", entry["step"] * batch if batch else None)
+        validations.append(entry)
+    return validations
+
+
+def format_count(value: float) -> str:
+    return f"{value / 1e6:.2f}M" if value >= 1e6 else f"{value / 1e3:.0f}k"
 
 
 def main() -> int:
@@ -19,6 +79,12 @@ def main() -> int:
     parser.add_argument("logs", nargs="+", type=pathlib.Path, help="OUT.log.jsonl files")
     parser.add_argument("--batch", action="append", default=[], metavar="NAME=B",
                         help="batch size of the log whose file name starts with NAME")
+    parser.add_argument("--fit", action="store_true",
+                        help="fit a power law to each log's validation translation error")
+    parser.add_argument("--fit-from", type=parse_count, default=0.0, metavar="SAMPLES",
+                        help="fit only the validations from this many samples on (e.g. 100k)")
+    parser.add_argument("--plot", type=pathlib.Path, metavar="PNG",
+                        help="write the curves (and fits) on log-log axes to this PNG")
     args = parser.parse_args()
     given = {}
     for item in args.batch:
@@ -27,34 +93,106 @@ def main() -> int:
             parser.error(f"--batch {item}: expected NAME=B with B a number")
         given[name] = int(size)
 
-    print("| run | steps | samples | translation (m) | rotation (°) "
-          "| one step: free flight / moving contact / rest (mm) |")
-    print("|---|---|---|---|---|---|")
+    runs = []
     for log in args.logs:
         name = log.name.removesuffix(".log.jsonl").removesuffix(".h5")
         batch = next((b for prefix, b in given.items() if name.startswith(prefix)), None)
         try:
-            lines = log.read_text().splitlines()
+            runs.append((name, read_validations(log, batch)))
         except OSError as e:
             print(f"training-log.py: {log}: {e.strerror}", file=sys.stderr)
             return 1
-        for number, line in enumerate(lines, 1):
-            try:
-                entry = json.loads(line)
-            except json.JSONDecodeError:
-                print(f"training-log.py: {log}:{number}: not a JSON line", file=sys.stderr)
-                return 1
-            if "valid_translation_m" not in entry:
-                continue
-            step = entry["step"]
-            seen = entry.get("samples", step * batch if batch else None)
+        except ValueError as e:
+            print(f"training-log.py: {e}", file=sys.stderr)
+            return 1
+
+    print("| run | steps | samples | translation (m) | rotation (°) "
+          "| one step: free flight / moving contact / rest (mm) |")
+    print("|---|---|---|---|---|---|")
+    for name, validations in runs:
+        for entry in validations:
+            seen = entry["samples"]
             samples = f"{seen / 1000:.0f}k" if seen is not None else "?"
             one_step = " / ".join(
                 f"{1e3 * entry[key]:.2f}" if key in entry else "-"
                 for key in ("valid_one_step_m_free_flight", "valid_one_step_m_moving_contact",
                             "valid_one_step_m_rest"))
-            print(f"| {name} | {step} | {samples} | {entry['valid_translation_m']:.3f} "
+            print(f"| {name} | {entry['step']} | {samples} | {entry['valid_translation_m']:.3f} "
                   f"| {entry['valid_rotation_deg']:.1f} | {one_step} |")
+
+    fits = {}
+    if args.fit or args.plot:
+        for name, validations in runs:
+            points = [(v["samples"], v["valid_translation_m"]) for v in validations
+                      if v["samples"] and v["samples"] >= args.fit_from
+                      and v["valid_translation_m"] > 0]
+            if any(v["samples"] is None for v in validations):
+                print(f"training-log.py: {name}: samples unknown (give --batch {name}=B)",
+                      file=sys.stderr)
+                return 1
+            if len(points) < 2 or len({s for s, _ in points}) < 2:
+                print(f"training-log.py: {name}: fewer than 2 validations from "
+                      f"{format_count(args.fit_from)} samples on: no fit", file=sys.stderr)
+                continue
+            fits[name] = (points, power_law_fit(*zip(*points)))
+    if args.fit and fits:
+        print()
+        print("| run | validations fitted | slope of ln(error) vs ln(samples) | fit at the last "
+              "| at 10× the samples | at 100× |")
+        print("|---|---|---|---|---|---|")
+        for name, (points, (intercept, slope, slope_error)) in fits.items():
+            last = max(s for s, _ in points)
+
+            def at(samples, b=slope):
+                # The line through the fitted points' centre, with slope b.
+                xs = [math.log(s) for s, _ in points]
+                centre_x = sum(xs) / len(xs)
+                centre_y = intercept + slope * centre_x
+                return math.exp(centre_y + b * (math.log(samples) - centre_x))
+
+            def reach(factor):
+                text = f"{at(last * factor):.3f} m ({format_count(last * factor)})"
+                if slope_error is not None:
+                    low, high = sorted((at(last * factor, slope - slope_error),
+                                        at(last * factor, slope + slope_error)))
+                    text += f", {low:.3f}–{high:.3f}"
+                return text
+
+            spread = f" ± {slope_error:.3f}" if slope_error is not None else ""
+            print(f"| {name} | {len(points)} ({format_count(min(s for s, _ in points))}–"
+                  f"{format_count(last)}) | {slope:.3f}{spread} | {at(last):.3f} m "
+                  f"| {reach(10)} | {reach(100)} |")
+    if args.plot:
+        try:
+            import matplotlib
+            matplotlib.use("Agg")
+            import matplotlib.pyplot as plt
+        except ImportError:
+            print("training-log.py: --plot needs matplotlib (apt-get install python3-matplotlib)",
+                  file=sys.stderr)
+            return 1
+        figure, axes = plt.subplots(figsize=(7, 4.5))
+        for name, validations in runs:
+            known = [(v["samples"], v["valid_translation_m"]) for v in validations if v["samples"]]
+            if not known:
+                continue
+            line, = axes.plot(*zip(*known), "o-", markersize=3, label=name)
+            if name in fits:
+                points, (intercept, slope, _) = fits[name]
+                ends = [min(s for s, _ in points), 100 * max(s for s, _ in points)]
+                axes.plot(ends, [math.exp(intercept + slope * math.log(s)) for s in ends], "--",
+                          color=line.get_color(), label=f"{name}: fit, slope {slope:.2f}")
+        axes.set_xscale("log")
+        axes.set_yscale("log")
+        axes.set_xlabel("samples seen")
+        axes.set_ylabel("validation translation error (m)")
+        axes.grid(True, which="both", alpha=0.3)
+        axes.legend(fontsize=8)
+        figure.tight_layout()
+        temporary = args.plot.with_name(args.plot.name + ".tmp.png")
+        figure.savefig(temporary, dpi=110)
+        temporary.replace(args.plot)
+        print(f"\nplot: {args.plot}")
     return 0
 
 

@@ -1,0 +1,87 @@
+"""The scripts of scripts/ that read `fignet train`'s logs."""
+
+import json
+import math
+import re
+import subprocess
+import sys
+
+
+def run_training_log(source_dir, *args):
+    return subprocess.run([sys.executable, str(source_dir / "scripts" / "training-log.py"), *args],
+                          capture_output=True, text=True)
+
+
+def write_log(path, validations):
+    """A log of (samples, translation) validations at batch 8, with loss lines between them."""
+    with open(path, "w") as log:
+        for samples, translation in validations:
+            log.write(json.dumps({"step": samples // 8, "samples": samples, "loss": 0.5}) + "\n")
+            log.write(json.dumps({"step": samples // 8, "samples": samples,
+                                  "valid_translation_m": translation,
+                                  "valid_rotation_deg": 40.0}) + "\n")
+
+
+def fit_row(stdout, name):
+    rows = [line for line in stdout.splitlines() if line.startswith(f"| {name} |")
+            and "validations fitted" not in line and "(" in line.split("|")[2]]
+    assert len(rows) == 1, stdout
+    return [cell.strip() for cell in rows[0].strip("|").split("|")]
+
+
+def test_fit_recovers_an_exact_power_law(source_dir, tmp_path):
+    # error = 3·samples^-0.3 exactly: the slope is -0.3 with no spread, and the extrapolations
+    # are the law's own values.
+    samples = [25_000 * k for k in range(1, 9)]
+    write_log(tmp_path / "law.h5.log.jsonl", [(s, 3.0 * s ** -0.3) for s in samples])
+    result = run_training_log(source_dir, "--fit", str(tmp_path / "law.h5.log.jsonl"))
+    assert result.returncode == 0, result.stderr
+    cells = fit_row(result.stdout, "law")
+    assert cells[1].startswith("8 (25k–200k)")
+    assert cells[2] == "-0.300 ± 0.000"
+    last = samples[-1]
+    assert cells[3] == f"{3.0 * last ** -0.3:.3f} m"
+    ten = 3.0 * (10 * last) ** -0.3
+    assert cells[4].startswith(f"{ten:.3f} m (2.00M), {ten:.3f}–{ten:.3f}")
+
+
+def test_fit_from_leaves_out_the_early_validations(source_dir, tmp_path):
+    # Two laws joined at 100k: fitting from 100k on sees only the second one's slope.
+    early = [(s, 10.0 * s ** -0.5) for s in (25_000, 50_000, 75_000)]
+    joint = 10.0 * 100_000 ** -0.5 / 100_000 ** -0.1
+    late = [(s, joint * s ** -0.1) for s in (100_000, 200_000, 400_000, 800_000)]
+    write_log(tmp_path / "two.h5.log.jsonl", early + late)
+    whole = fit_row(run_training_log(source_dir, "--fit", str(tmp_path / "two.h5.log.jsonl")).stdout,
+                    "two")
+    tail = fit_row(run_training_log(source_dir, "--fit", "--fit-from", "100k",
+                                    str(tmp_path / "two.h5.log.jsonl")).stdout, "two")
+    assert tail[2] == "-0.100 ± 0.000"
+    assert float(whole[2].split()[0]) < -0.15
+
+
+def test_the_slope_error_is_the_least_squares_one(source_dir, tmp_path):
+    # Scattered points: the slope and its standard error against the textbook formulas.
+    points = [(20_000, 1.9), (40_000, 1.4), (60_000, 1.6), (80_000, 1.1), (100_000, 1.2)]
+    write_log(tmp_path / "noisy.h5.log.jsonl", points)
+    cells = fit_row(run_training_log(source_dir, "--fit",
+                                     str(tmp_path / "noisy.h5.log.jsonl")).stdout, "noisy")
+    xs = [math.log(s) for s, _ in points]
+    ys = [math.log(e) for _, e in points]
+    mx, my = sum(xs) / 5, sum(ys) / 5
+    sxx = sum((x - mx) ** 2 for x in xs)
+    slope = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sxx
+    residual = sum((y - my - slope * (x - mx)) ** 2 for x, y in zip(xs, ys))
+    assert cells[2] == f"{slope:.3f} ± {math.sqrt(residual / 3 / sxx):.3f}"
+
+
+def test_bad_logs_and_counts_are_named(source_dir, tmp_path):
+    bad = tmp_path / "bad.log.jsonl"
+    bad.write_text('{"step": 1}\nnot json\n')
+    result = run_training_log(source_dir, str(bad))
+    assert result.returncode == 1
+    assert re.search(r"bad\.log\.jsonl:2: not a JSON line", result.stderr)
+    result = run_training_log(source_dir, "--fit", "--fit-from", "lots", str(bad))
+    assert result.returncode == 2
+    assert "'lots' is not a sample count" in result.stderr
+    result = run_training_log(source_dir, str(tmp_path / "missing.log.jsonl"))
+    assert result.returncode == 1 and "missing.log.jsonl" in result.stderr
