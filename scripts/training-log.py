@@ -30,16 +30,18 @@ def parse_count(text: str) -> float:
     try:
         value = float(number) * scale
     except ValueError:
-        raise argparse.ArgumentTypeError(f"'{text}' is not a sample count (e.g. 100000, 100k, 1.2M)")
+        raise argparse.ArgumentTypeError(
+            f"'{text}' is not a sample count (e.g. 100000, 100k, 1.2M)")
     if value < 0:
         raise argparse.ArgumentTypeError(f"'{text}': a sample count is not negative")
     return value
 
 
 def power_law_fit(samples, errors):
-    """Least squares of ln(error) = intercept + slope·ln(samples).
+    """Least squares of ln(error) against ln(samples).
 
-    Returns (intercept, slope, slope's standard error; None with fewer than 3 points)."""
+    Returns (centre, slope, slope's standard error): the line passes through centre = (mean
+    ln(samples), mean ln(error)); the standard error is None with fewer than 3 points."""
     xs = [math.log(s) for s in samples]
     ys = [math.log(e) for e in errors]
     n = len(xs)
@@ -48,11 +50,16 @@ def power_law_fit(samples, errors):
     if sxx == 0:
         raise ValueError("every validation is at the same sample count")
     slope = sum((x - mean_x) * (y - mean_y) for x, y in zip(xs, ys)) / sxx
-    intercept = mean_y - slope * mean_x
     if n < 3:
-        return intercept, slope, None
-    residuals = sum((y - intercept - slope * x) ** 2 for x, y in zip(xs, ys))
-    return intercept, slope, math.sqrt(residuals / (n - 2) / sxx)
+        return (mean_x, mean_y), slope, None
+    residuals = sum((y - mean_y - slope * (x - mean_x)) ** 2 for x, y in zip(xs, ys))
+    return (mean_x, mean_y), slope, math.sqrt(residuals / (n - 2) / sxx)
+
+
+def power_law_at(centre, slope, samples):
+    """The fitted error at `samples`; another slope through the same centre gives the range its
+    standard error allows."""
+    return math.exp(centre[1] + slope * (math.log(samples) - centre[0]))
 
 
 def read_validations(log: pathlib.Path, batch):
@@ -123,13 +130,13 @@ def main() -> int:
     fits = {}
     if args.fit or args.plot:
         for name, validations in runs:
-            points = [(v["samples"], v["valid_translation_m"]) for v in validations
-                      if v["samples"] and v["samples"] >= args.fit_from
-                      and v["valid_translation_m"] > 0]
             if any(v["samples"] is None for v in validations):
                 print(f"training-log.py: {name}: samples unknown (give --batch {name}=B)",
                       file=sys.stderr)
                 return 1
+            points = [(v["samples"], v["valid_translation_m"]) for v in validations
+                      if v["samples"] > 0 and v["samples"] >= args.fit_from
+                      and v["valid_translation_m"] > 0]
             if len(points) < 2 or len({s for s, _ in points}) < 2:
                 print(f"training-log.py: {name}: fewer than 2 validations from "
                       f"{format_count(args.fit_from)} samples on: no fit", file=sys.stderr)
@@ -140,27 +147,22 @@ def main() -> int:
         print("| run | validations fitted | slope of ln(error) vs ln(samples) | fit at the last "
               "| at 10× the samples | at 100× |")
         print("|---|---|---|---|---|---|")
-        for name, (points, (intercept, slope, slope_error)) in fits.items():
+        for name, (points, (centre, slope, slope_error)) in fits.items():
             last = max(s for s, _ in points)
 
-            def at(samples, b=slope):
-                # The line through the fitted points' centre, with slope b.
-                xs = [math.log(s) for s, _ in points]
-                centre_x = sum(xs) / len(xs)
-                centre_y = intercept + slope * centre_x
-                return math.exp(centre_y + b * (math.log(samples) - centre_x))
-
             def reach(factor):
-                text = f"{at(last * factor):.3f} m ({format_count(last * factor)})"
+                samples = last * factor
+                text = f"{power_law_at(centre, slope, samples):.3f} m ({format_count(samples)})"
                 if slope_error is not None:
-                    low, high = sorted((at(last * factor, slope - slope_error),
-                                        at(last * factor, slope + slope_error)))
+                    low, high = sorted(power_law_at(centre, slope + sign * slope_error, samples)
+                                       for sign in (-1, 1))
                     text += f", {low:.3f}–{high:.3f}"
                 return text
 
             spread = f" ± {slope_error:.3f}" if slope_error is not None else ""
+            at_last = power_law_at(centre, slope, last)
             print(f"| {name} | {len(points)} ({format_count(min(s for s, _ in points))}–"
-                  f"{format_count(last)}) | {slope:.3f}{spread} | {at(last):.3f} m "
+                  f"{format_count(last)}) | {slope:.3f}{spread} | {at_last:.3f} m "
                   f"| {reach(10)} | {reach(100)} |")
     if args.plot:
         try:
@@ -178,9 +180,9 @@ def main() -> int:
                 continue
             line, = axes.plot(*zip(*known), "o-", markersize=3, label=name)
             if name in fits:
-                points, (intercept, slope, _) = fits[name]
+                points, (centre, slope, _) = fits[name]
                 ends = [min(s for s, _ in points), 100 * max(s for s, _ in points)]
-                axes.plot(ends, [math.exp(intercept + slope * math.log(s)) for s in ends], "--",
+                axes.plot(ends, [power_law_at(centre, slope, s) for s in ends], "--",
                           color=line.get_color(), label=f"{name}: fit, slope {slope:.2f}")
         axes.set_xscale("log")
         axes.set_yscale("log")
