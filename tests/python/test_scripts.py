@@ -1,7 +1,9 @@
-"""The scripts of scripts/ that read `fignet train`'s logs."""
+"""The scripts of scripts/: training-log.py, which reads `fignet train`'s logs, and the
+measurements of model-card.sh."""
 
 import json
 import math
+import os
 import re
 import subprocess
 import sys
@@ -85,3 +87,26 @@ def test_bad_logs_and_counts_are_named(source_dir, tmp_path):
     assert "'lots' is not a sample count" in result.stderr
     result = run_training_log(source_dir, str(tmp_path / "missing.log.jsonl"))
     assert result.returncode == 1 and "missing.log.jsonl" in result.stderr
+
+
+def test_model_card_names_what_it_lacks(source_dir, tmp_path):
+    # Checked before any measurement starts: the arguments, the model, the tool, the test split
+    # (looked for relative to the working directory, here one without data/).
+    script = str(source_dir / "scripts" / "model-card.sh")
+    env = dict(os.environ, FIGNET=os.environ["FIGNET_CLI"])
+
+    def card(*args):
+        return subprocess.run(["bash", script, *args], capture_output=True, text=True,
+                              cwd=tmp_path, env=env)
+
+    result = card()
+    assert result.returncode == 2 and "usage:" in result.stderr
+    result = card("missing.h5")
+    assert result.returncode == 2 and "no model file 'missing.h5'" in result.stderr
+    model = str(source_dir / "models" / "movi-a-small.h5")
+    result = subprocess.run(["bash", script, model], capture_output=True, text=True, cwd=tmp_path,
+                            env=dict(env, FIGNET=str(tmp_path / "none")))
+    assert result.returncode == 2 and "no fignet tool" in result.stderr
+    result = card(model)
+    assert result.returncode == 2 and "data/movi-a/test.h5 is missing" in result.stderr
+    assert not (tmp_path / "out").exists()
