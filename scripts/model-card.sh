@@ -55,10 +55,11 @@ fi
 
 log="$model.log.jsonl"
 if [[ -f "$log" ]]; then
-  "$python" scripts/training-log.py --fit --fit-from 100k "$log" >"$out/curve.md"
+  # One reading of the log: the table always, the plot where matplotlib is there to draw it.
+  plot=(--plot "$out/curve.png")
   "$python" -c "import matplotlib" 2>/dev/null \
-    && "$python" scripts/training-log.py --fit --fit-from 100k --plot "$out/curve.png" "$log" >/dev/null \
-    || echo "(no matplotlib: curve.png not drawn; Debian's python3-matplotlib draws it)"
+    || { plot=(); echo "(no matplotlib: curve.png not drawn; Debian's python3-matplotlib draws it)"; }
+  "$python" scripts/training-log.py --fit --fit-from 100k "${plot[@]}" "$log" >"$out/curve.md"
 fi
 grep -h -E "\) +[0-9.]+ +[0-9.]+ +[0-9.]+" "$out/test-turns1.txt" "$out/test-turns2.txt" || true
 echo "figures in $out/"

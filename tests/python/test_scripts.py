@@ -95,17 +95,16 @@ def test_model_card_names_what_it_lacks(source_dir, tmp_path):
     script = str(source_dir / "scripts" / "model-card.sh")
     env = dict(os.environ, FIGNET=os.environ["FIGNET_CLI"])
 
-    def card(*args):
+    def card(*args, **changes):
         return subprocess.run(["bash", script, *args], capture_output=True, text=True,
-                              cwd=tmp_path, env=env)
+                              cwd=tmp_path, env=dict(env, **changes))
 
     result = card()
     assert result.returncode == 2 and "usage:" in result.stderr
     result = card("missing.h5")
     assert result.returncode == 2 and "no model file 'missing.h5'" in result.stderr
     model = str(source_dir / "models" / "movi-a-small.h5")
-    result = subprocess.run(["bash", script, model], capture_output=True, text=True, cwd=tmp_path,
-                            env=dict(env, FIGNET=str(tmp_path / "none")))
+    result = card(model, FIGNET=str(tmp_path / "none"))
     assert result.returncode == 2 and "no fignet tool" in result.stderr
     result = card(model)
     assert result.returncode == 2 and "data/movi-a/test.h5 is missing" in result.stderr
