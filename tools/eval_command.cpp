@@ -128,24 +128,31 @@ void print_regimes(const std::vector<Row>& rows) {
   fmt::print(
       "\none-step error by regime, from every ground-truth frame (free flight: no collision edge "
       "in the input; rest: in contact and, in the truth, slower than 0.05 m/s and 0.25 rad/s; "
-      "σ: the model's target standard deviation)\n");
-  fmt::print("{:<34} {:<15} {:>7} {:>16} {:>14} {:>9}\n", "run", "regime", "share",
-             "translation (mm)", "rotation (deg)", "RMS (σ)");
+      "σ: the model's target standard deviation; ahead: the signed error along the body's motion "
+      "into the step, > 0 when it keeps more speed than the truth; up: against gravity; impacts: "
+      "|a - g| > 2 g in the truth, whatever the regime)\n");
+  fmt::print("{:<34} {:<15} {:>7} {:>16} {:>11} {:>9} {:>14} {:>9}\n", "run", "regime", "share",
+             "translation (mm)", "ahead (mm)", "up (mm)", "rotation (deg)", "RMS (σ)");
   for (const Row& row : rows) {
     if (!row.one_step) continue;
     const OneStepTotals& t = *row.one_step;
     double samples = 0;
     for (const RegimeTotals& r : t.regimes) samples += r.samples;
+    const auto print_row = [&](const std::string& run, std::string_view group,
+                               const RegimeTotals& r) {
+      fmt::print("{:<34} {:<15} {:>6.1f}% {:>16.2f} {:>11.2f} {:>9.2f} {:>14.3f} {:>9.3f}\n", run,
+                 group, 100.0 * r.samples / std::max(samples, 1.0), 1e3 * mean_translation(r),
+                 1e3 * mean_ahead(r), 1e3 * mean_up(r), r.rotation / std::max(r.samples, 1.0),
+                 rms_sigmas(r));
+    };
     for (int k = 0; k < kRegimes; ++k) {
-      const RegimeTotals& r = t.regimes[k];
-      fmt::print("{:<34} {:<15} {:>6.1f}% {:>16.2f} {:>14.3f} {:>9.3f}\n",
-                 k == 0 ? fmt::format("{} ({})", row.name, row.kind) : "",
-                 regime_name(static_cast<Regime>(k)), 100.0 * r.samples / std::max(samples, 1.0),
-                 1e3 * mean_translation(r), r.rotation / std::max(r.samples, 1.0), rms_sigmas(r));
+      print_row(k == 0 ? fmt::format("{} ({})", row.name, row.kind) : "",
+                regime_name(static_cast<Regime>(k)), t.regimes[k]);
     }
+    print_row("", "impacts", t.impact_errors);
     fmt::print(
-        "{:<34} impacts (|a - g| > 2 g): {:.0f} object-steps, {:.0f} ({:.1f}%) with no "
-        "collision edge in their input\n",
+        "{:<34} impacts: {:.0f} object-steps, {:.0f} ({:.1f}%) with no collision edge in "
+        "their input\n",
         "", t.impacts, t.unseen_impacts, 100.0 * t.unseen_impacts / std::max(t.impacts, 1.0));
   }
 }
@@ -182,14 +189,18 @@ nlohmann::json to_json(const Row& row) {
   nlohmann::json regimes = nullptr;
   if (row.one_step) {
     regimes = nlohmann::json::object();
+    const auto group = [](const RegimeTotals& r) {
+      return nlohmann::json{{"object_steps", r.samples},
+                            {"mean_translation_m", mean_translation(r)},
+                            {"mean_ahead_m", mean_ahead(r)},
+                            {"mean_up_m", mean_up(r)},
+                            {"mean_rotation_deg", r.rotation / std::max(r.samples, 1.0)},
+                            {"rms_sigmas", rms_sigmas(r)}};
+    };
     for (int k = 0; k < kRegimes; ++k) {
-      const RegimeTotals& r = row.one_step->regimes[k];
-      regimes[std::string(regime_name(static_cast<Regime>(k)))] = {
-          {"object_steps", r.samples},
-          {"mean_translation_m", mean_translation(r)},
-          {"mean_rotation_deg", r.rotation / std::max(r.samples, 1.0)},
-          {"rms_sigmas", rms_sigmas(r)}};
+      regimes[std::string(regime_name(static_cast<Regime>(k)))] = group(row.one_step->regimes[k]);
     }
+    regimes["impact steps"] = group(row.one_step->impact_errors);
     regimes["impacts"] = row.one_step->impacts;
     regimes["unseen_impacts"] = row.one_step->unseen_impacts;
   }

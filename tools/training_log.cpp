@@ -81,6 +81,8 @@ void TrainingLog::write_validation(std::int64_t step, const Evaluation& e,
     line["valid_one_step_m_" + name] = mean_translation(one_step.regimes[r]);
     line["valid_one_step_sigma_" + name] = rms_sigmas(one_step.regimes[r]);
   }
+  line["valid_one_step_m_impacts"] = mean_translation(one_step.impact_errors);
+  line["valid_one_step_ahead_m_impacts"] = mean_ahead(one_step.impact_errors);
   out_ << line.dump() << std::endl;
 }
 

@@ -58,10 +58,19 @@ TEST(OneStep, RegimesAndUnseenImpactsOfADrop) {
     // Every one of the 8 vertices errs by the same vector.
     r.squared_sigmas += 8 * error.cwiseQuotient(sigma).squaredNorm();
     r.components += 24;
+    // Signed: along the motion into the step, and upward (gravity is -z).
+    const Vec3 incoming = x[t] - x[t - 1];
+    const double ahead = incoming.norm() > 0 ? error.dot(incoming.normalized()) : 0.0;
+    r.ahead += ahead;
+    r.up += error.z();
     const Vec3 acceleration = (x[t + 1] - 2 * x[t] + x[t - 1]) / (dt * dt);
     if ((acceleration - g).norm() > 2 * g.norm()) {
       expected.impacts += 1;
       if (!edge) expected.unseen_impacts += 1;
+      expected.impact_errors.samples += 1;
+      expected.impact_errors.translation += error.norm();
+      expected.impact_errors.ahead += ahead;
+      expected.impact_errors.up += error.z();
     }
   }
   ASSERT_GT(expected.unseen_impacts, 0) << "the drop should hit the floor from beyond d_c";
@@ -73,7 +82,18 @@ TEST(OneStep, RegimesAndUnseenImpactsOfADrop) {
     EXPECT_NEAR(totals.regimes[r].rotation, 0.0, 1e-6);
     EXPECT_NEAR(totals.regimes[r].squared_sigmas, expected.regimes[r].squared_sigmas, 1e-9);
     EXPECT_EQ(totals.regimes[r].components, expected.regimes[r].components);
+    EXPECT_NEAR(totals.regimes[r].ahead, expected.regimes[r].ahead, 1e-9);
+    EXPECT_NEAR(totals.regimes[r].up, expected.regimes[r].up, 1e-9);
   }
+  // Ballistic through a landing and a slide: it keeps going where the floor and friction stop
+  // the truth (ahead > 0), and falls below where the floor holds it (up < 0).
+  EXPECT_GT(mean_ahead(totals.regimes[1]), 0.0);
+  EXPECT_LT(mean_up(totals.regimes[1]), 0.0);
+  ASSERT_GT(expected.impact_errors.samples, 0);
+  EXPECT_EQ(totals.impact_errors.samples, expected.impact_errors.samples);
+  EXPECT_NEAR(totals.impact_errors.translation, expected.impact_errors.translation, 1e-9);
+  EXPECT_NEAR(totals.impact_errors.ahead, expected.impact_errors.ahead, 1e-9);
+  EXPECT_NEAR(totals.impact_errors.up, expected.impact_errors.up, 1e-9);
   // The ballistic predictor errs in free flight only at the unseen impact, by the floor's stop.
   const int impact = landed - 1;
   EXPECT_NEAR(totals.regimes[0].translation,
@@ -86,6 +106,9 @@ TEST(OneStep, RegimesAndUnseenImpactsOfADrop) {
   twice += OneStepTotals::deserialize(totals.serialize());
   EXPECT_EQ(twice.regimes[2].samples, 2 * totals.regimes[2].samples);
   EXPECT_EQ(twice.unseen_impacts, 2 * totals.unseen_impacts);
+  EXPECT_NEAR(twice.regimes[1].ahead, 2 * totals.regimes[1].ahead, 1e-12);
+  EXPECT_EQ(twice.impact_errors.samples, 2 * totals.impact_errors.samples);
+  EXPECT_NEAR(twice.impact_errors.up, 2 * totals.impact_errors.up, 1e-12);
   EXPECT_THROW(OneStepTotals::deserialize(std::vector<double>(3)), ConfigError);
 
   // Shared among threads, each with its own predictor: the same sums.
@@ -99,6 +122,7 @@ TEST(OneStep, RegimesAndUnseenImpactsOfADrop) {
     EXPECT_NEAR(rms_sigmas(threaded.regimes[r]), rms_sigmas(totals.regimes[r]), 1e-12);
   }
   EXPECT_EQ(threaded.unseen_impacts, 3 * totals.unseen_impacts);
+  EXPECT_NEAR(mean_ahead(threaded.impact_errors), mean_ahead(totals.impact_errors), 1e-12);
 }
 
 }  // namespace

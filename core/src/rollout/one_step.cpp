@@ -24,43 +24,61 @@ std::string_view regime_name(Regime regime) {
   return "?";
 }
 
+void RegimeTotals::add(const RegimeTotals& other) {
+  samples += other.samples;
+  translation += other.translation;
+  rotation += other.rotation;
+  squared_sigmas += other.squared_sigmas;
+  components += other.components;
+  ahead += other.ahead;
+  up += other.up;
+}
+
 OneStepTotals& OneStepTotals::operator+=(const OneStepTotals& other) {
-  for (int r = 0; r < kRegimes; ++r) {
-    RegimeTotals& mine = regimes[r];
-    const RegimeTotals& theirs = other.regimes[r];
-    mine.samples += theirs.samples;
-    mine.translation += theirs.translation;
-    mine.rotation += theirs.rotation;
-    mine.squared_sigmas += theirs.squared_sigmas;
-    mine.components += theirs.components;
-  }
+  for (int r = 0; r < kRegimes; ++r) regimes[r].add(other.regimes[r]);
+  impact_errors.add(other.impact_errors);
   impacts += other.impacts;
   unseen_impacts += other.unseen_impacts;
   return *this;
 }
 
+namespace {
+
+constexpr size_t kRegimeValues = 7;
+
+void append(const RegimeTotals& r, std::vector<double>& out) {
+  out.insert(out.end(),
+             {r.samples, r.translation, r.rotation, r.squared_sigmas, r.components, r.ahead, r.up});
+}
+
+RegimeTotals regime_from(const double* v) {
+  return {v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
+}
+
+}  // namespace
+
+// [each regime's 7 sums, the impacts' 7 sums, impacts, unseen impacts].
 std::vector<double> OneStepTotals::serialize() const {
   std::vector<double> out;
-  for (const RegimeTotals& r : regimes) {
-    out.insert(out.end(), {r.samples, r.translation, r.rotation, r.squared_sigmas, r.components});
-  }
+  for (const RegimeTotals& r : regimes) append(r, out);
+  append(impact_errors, out);
   out.insert(out.end(), {impacts, unseen_impacts});
   return out;
 }
 
 OneStepTotals OneStepTotals::deserialize(std::span<const double> values) {
-  constexpr size_t kSize = 5 * kRegimes + 2;
+  constexpr size_t kSize = kRegimeValues * (kRegimes + 1) + 2;
   if (values.size() != kSize) {
     throw ConfigError("OneStepTotals: expected " + std::to_string(kSize) + " values, got " +
                       std::to_string(values.size()));
   }
   OneStepTotals totals;
   for (int r = 0; r < kRegimes; ++r) {
-    const double* v = values.data() + 5 * r;
-    totals.regimes[r] = {v[0], v[1], v[2], v[3], v[4]};
+    totals.regimes[r] = regime_from(values.data() + kRegimeValues * r);
   }
-  totals.impacts = values[5 * kRegimes];
-  totals.unseen_impacts = values[5 * kRegimes + 1];
+  totals.impact_errors = regime_from(values.data() + kRegimeValues * kRegimes);
+  totals.impacts = values[kSize - 2];
+  totals.unseen_impacts = values[kSize - 1];
   return totals;
 }
 
@@ -110,7 +128,8 @@ OneStepTotals one_step_totals(AccelerationPredictor& predictor, const GraphConfi
         const Vec3 acceleration =
             (after.position - 2.0 * now.position + before.position) / (dt * dt);
         const bool edge = interacting[o] != 0;
-        if ((acceleration - truth.gravity).norm() > options.impact_g * g) {
+        const bool impact = (acceleration - truth.gravity).norm() > options.impact_g * g;
+        if (impact) {
           totals.impacts += 1;
           if (!edge) totals.unseen_impacts += 1;
         }
@@ -119,18 +138,26 @@ OneStepTotals one_step_totals(AccelerationPredictor& predictor, const GraphConfi
             : speed < options.rest_speed && angular_speed < options.rest_angular_speed
                 ? Regime::kRest
                 : Regime::kContact;
-        RegimeTotals& r = totals.regimes[static_cast<int>(regime)];
-        r.samples += 1;
-        r.translation += (next[o].position - after.position).norm();
-        r.rotation +=
+        // The centre's error, whole and signed along the incoming motion and against gravity.
+        RegimeTotals step;
+        step.samples = 1;
+        const Vec3 error = next[o].position - after.position;
+        step.translation = error.norm();
+        step.rotation =
             next[o].orientation.angularDistance(after.orientation) * 180.0 / std::numbers::pi;
+        const Vec3 incoming = now.position - before.position;
+        if (incoming.norm() > 0) step.ahead = error.dot(incoming.normalized());
+        if (g > 0) step.up = -error.dot(truth.gravity / g);
         // Vertex accelerations in the model's normalised units.
         const Points truth_next = posed_vertices(*object.mesh, after);
         const Points true_acceleration =
             truth_next - 2.0 * object.positions_at(h) + object.positions_at(h - 1);
-        const Points error = accelerations.middleRows(first, v) - true_acceleration;
-        r.squared_sigmas += (error.array().rowwise() * inverse_std.transpose()).square().sum();
-        r.components += 3.0 * static_cast<double>(v);
+        const Points vertex_error = accelerations.middleRows(first, v) - true_acceleration;
+        step.squared_sigmas =
+            (vertex_error.array().rowwise() * inverse_std.transpose()).square().sum();
+        step.components = 3.0 * static_cast<double>(v);
+        totals.regimes[static_cast<int>(regime)].add(step);
+        if (impact) totals.impact_errors.add(step);
       }
     }
     if (options.on_trajectory) options.on_trajectory(++done);
@@ -157,6 +184,14 @@ OneStepTotals one_step_totals_parallel(
 
 double mean_translation(const RegimeTotals& totals) {
   return totals.samples > 0 ? totals.translation / totals.samples : 0.0;
+}
+
+double mean_ahead(const RegimeTotals& totals) {
+  return totals.samples > 0 ? totals.ahead / totals.samples : 0.0;
+}
+
+double mean_up(const RegimeTotals& totals) {
+  return totals.samples > 0 ? totals.up / totals.samples : 0.0;
 }
 
 double rms_sigmas(const RegimeTotals& totals) {

@@ -39,11 +39,20 @@ struct RegimeTotals {
   double rotation = 0;        // Σ angle between predicted and true orientation, degrees
   double squared_sigmas = 0;  // Σ over vertex components of ((â − a)/σ)², σ: the target's std
   double components = 0;      // vertex components summed there
+  // Signed parts of x̂ − x, metres, which a mean |x̂ − x| hides: a bias adds up over a rollout
+  // where noise partly cancels. `ahead`: along the centre's motion into the step (x_t − x_{t−1};
+  // > 0: the body keeps more of its speed than the truth, e.g. too little friction or too soft an
+  // impact); `up`: against gravity (> 0: falls or bounces less deep, rises more).
+  double ahead = 0, up = 0;
+  void add(const RegimeTotals& other);
 };
 
 struct OneStepTotals {
   std::array<RegimeTotals, kRegimes> regimes{};
   double impacts = 0, unseen_impacts = 0;  // object-steps
+  // The impacts' errors (every regime's object-steps whose truth is an impact): one impact's
+  // error becomes a velocity error that a rollout carries from then on.
+  RegimeTotals impact_errors;
   OneStepTotals& operator+=(const OneStepTotals& other);
   std::vector<double> serialize() const;
   static OneStepTotals deserialize(std::span<const double> values);
@@ -67,6 +76,9 @@ OneStepTotals one_step_totals_parallel(
 // Per regime: mean translation error in metres and vertex-acceleration RMS in σ (0 when the
 // regime has no sample).
 double mean_translation(const RegimeTotals& totals);
+// Mean signed errors (metres) along the incoming motion and against gravity (0 without samples).
+double mean_ahead(const RegimeTotals& totals);
+double mean_up(const RegimeTotals& totals);
 double rms_sigmas(const RegimeTotals& totals);
 
 }  // namespace fignet
