@@ -209,6 +209,69 @@ TEST_F(TwoTetrahedra, DistanceLogarithmFollowsTheFaceEdgeRow) {
     EXPECT_NEAR(graph.face_edges.features.row(e)[34], std::log(51.0), 1e-5) << "edge " << e;
 }
 
+// contact_motion appends [u, |u|, u·n_s], u the receiver's closest point's motion over the last
+// frame less the sender's. A moved +0.02 m in x and B stood still: u = (-0.02, 0, 0) on the edges
+// A sends (n_s = A's bottom, -z: no approach) and (+0.02, 0, 0) on their twins.
+TEST_F(TwoTetrahedra, ContactMotionOfATranslation) {
+  GraphConfig config;
+  config.contact_motion = true;
+  Graph graph;
+  GraphBuilder(config).build(scene_, graph);
+  ASSERT_EQ(graph.face_edges.features.cols(), 39);
+  ASSERT_EQ(graph.face_edges.size(), graph_.face_edges.size());
+  for (int e = 0; e < graph_.face_edges.size(); ++e) {
+    const float* plain = graph_.face_edges.features.row(e);
+    std::vector<double> expected(plain, plain + 34);
+    const bool a_sends = graph.node_object[graph.face_edges.senders[3 * e]] == 0;
+    const Vec3 u(a_sends ? -0.02 : 0.02, 0, 0);
+    const Vec3 n_s(plain[31], plain[32], plain[33]);
+    expected.insert(expected.end(), {u.x(), u.y(), u.z(), u.norm(), u.dot(n_s)});
+    expect_row(graph.face_edges.features.row(e), expected);
+  }
+}
+
+// The same under rotation, against the rigid motions themselves: A turns about z (0.05 then
+// 0.12 rad) while B slides, and each closest point's motion is where the body's last-frame pose
+// puts that material point, subtracted from where it is now.
+TEST_F(TwoTetrahedra, ContactMotionFollowsRigidMotion) {
+  Scene scene = scene_;
+  const auto turn = [](double angle) {
+    return Eigen::Quaterniond(Eigen::AngleAxisd(angle, Vec3::UnitZ()));
+  };
+  const std::vector<Pose> a_poses = {
+      {Vec3(0, 0, 0), turn(0.0)}, {Vec3(0.01, 0, 0), turn(0.05)}, {Vec3(0.03, 0, 0), turn(0.12)}};
+  const Pose b_now{scene.objects[1].centers.row(2).transpose()};
+  const Pose b_before{b_now.position - Vec3(0, 0.01, -0.005), turn(-0.02)};
+  const std::vector<Pose> b_poses = {b_before, b_before, b_now};
+  set_pose_history(scene.objects[0], a_poses);
+  set_pose_history(scene.objects[1], b_poses, b_now);
+  GraphConfig config;
+  config.contact_motion = true;
+  Graph graph;
+  GraphBuilder(config).build(scene, graph);
+  ASSERT_GT(graph.face_edges.size(), 0);
+
+  const Pose now[2] = {a_poses[2], b_now}, before[2] = {a_poses[1], b_before};
+  const Points nodes[2] = {posed_vertices(mesh_, now[0]), posed_vertices(mesh_, now[1])};
+  const auto motion = [&](int object, const Vec3& p) {
+    const Vec3 local = now[object].orientation.conjugate() * (p - now[object].position);
+    return Vec3(p - before[object].apply(local));
+  };
+  for (int e = 0; e < graph.face_edges.size(); ++e) {
+    const float* row = graph.face_edges.features.row(e);
+    const int sender = graph.face_edges.senders[3 * e],
+              receiver = graph.face_edges.receivers[3 * e];
+    const int s = graph.node_object[sender], r = graph.node_object[receiver];
+    // The closest points from the first span of each face: p = x_j − (x_j − p).
+    const Vec3 p_s = nodes[s].row(sender - 4 * s).transpose() - Vec3(row[4], row[5], row[6]);
+    const Vec3 p_r = nodes[r].row(receiver - 4 * r).transpose() - Vec3(row[16], row[17], row[18]);
+    const Vec3 u = motion(r, p_r) - motion(s, p_s);
+    const Vec3 n_s(row[31], row[32], row[33]);
+    SCOPED_TRACE("edge " + std::to_string(e));
+    expect_row(row + 34, {u.x(), u.y(), u.z(), u.norm(), u.dot(n_s)});
+  }
+}
+
 TEST_F(TwoTetrahedra, ReverseEdgeSwapsRoles) {
   // Every face edge has a twin with senders and receivers exchanged and d_rs negated.
   for (int e = 0; e < graph_.face_edges.size(); e += 2) {

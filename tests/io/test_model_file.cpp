@@ -26,6 +26,7 @@ class ModelFile : public testing::TempFolderTest {
     config.graph.face_span_limit = 0.75;
     config.graph.velocity_log_scale = 1e-4;
     config.graph.distance_log_scale = 2e-3;
+    config.graph.contact_motion = true;
     Model fresh(config);
     Normalizers normalizers = fresh.normalizers();
     RowMatrixXf rows = RowMatrixXf::Random(10, normalizers.mesh_node.size());
@@ -65,7 +66,8 @@ TEST_F(ModelFile, SaveThenLoadIsBitExact) {
   EXPECT_EQ(loaded.config().graph.face_span_limit, 0.75);
   EXPECT_EQ(loaded.config().graph.velocity_log_scale, 1e-4);
   EXPECT_EQ(loaded.config().graph.distance_log_scale, 2e-3);
-  EXPECT_EQ(loaded.normalizers().face_edge.size(), 35);
+  EXPECT_TRUE(loaded.config().graph.contact_motion);
+  EXPECT_EQ(loaded.normalizers().face_edge.size(), 34 + 1 + 5);  // the logarithm, the motion
   EXPECT_EQ(loaded.normalizers().mesh_node.sum(), model_->normalizers().mesh_node.sum());
   EXPECT_EQ(loaded.normalizers().mesh_node.sum_squares(),
             model_->normalizers().mesh_node.sum_squares());

@@ -44,7 +44,7 @@ FeatureSizes feature_sizes(const GraphConfig& config) {
       .object_node = dynamic_part,
       .mesh_edge = 8,
       .world_edge = 4,
-      .face_edge = 34 + (config.distance_log_scale > 0.0 ? 1 : 0),
+      .face_edge = 34 + (config.distance_log_scale > 0.0 ? 1 : 0) + (config.contact_motion ? 5 : 0),
   };
 }
 

@@ -158,8 +158,33 @@ Vec3 current_normal(const PosedMesh& posed, int face) {
                          vertices.row(f(2)).transpose());
 }
 
+// How far the point p of a face moved over the last frame: its barycentric weights applied to
+// the face's vertex displacements (exact for a rigid motion, which moves points affinely).
+Vec3 point_motion(const PosedMesh& posed, int face, const Vec3& p) {
+  if (!posed.previous) return Vec3::Zero();
+  const auto now = posed.vertices();
+  const auto before = posed.previous_vertices();
+  const auto& f = posed.mesh->faces().row(face);
+  const Vec3 a = now.row(f(0)).transpose(), b = now.row(f(1)).transpose(),
+             c = now.row(f(2)).transpose();
+  const Vec3 e0 = b - a, e1 = c - a, d = p - a;
+  const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1);
+  const double denominator = d00 * d11 - d01 * d01;
+  // A degenerate face has no unique weights: its vertices' mean motion stands for the point's.
+  Eigen::Vector3d w = Eigen::Vector3d::Constant(1.0 / 3.0);
+  if (denominator > 1e-12 * d00 * d11) {
+    const double d20 = d.dot(e0), d21 = d.dot(e1);
+    w[1] = (d11 * d20 - d01 * d21) / denominator;
+    w[2] = (d00 * d21 - d01 * d20) / denominator;
+    w[0] = 1.0 - w[1] - w[2];
+  }
+  Vec3 motion = Vec3::Zero();
+  for (int k = 0; k < 3; ++k) motion += w[k] * (now.row(f(k)) - before.row(f(k))).transpose();
+  return motion;
+}
+
 // [d_rs, |d_rs|, (d_sj, |d_sj|)_j, (d_rj, |d_rj|)_j, n_r, n_s] (seed C.1.1), then
-// ln(1 + |d_rs|/s) when distance_log_scale s > 0.
+// ln(1 + |d_rs|/s) when distance_log_scale s > 0, then [u, |u|, u·n_s] when contact_motion.
 void put_face_edge(const GraphConfig& config, const PosedMesh& sender, int sender_face,
                    const Vec3& p_s, int sender_first, const PosedMesh& receiver, int receiver_face,
                    const Vec3& p_r, int receiver_first, FaceEdgeSet& out) {
@@ -169,12 +194,19 @@ void put_face_edge(const GraphConfig& config, const PosedMesh& sender, int sende
   float* row = put_vector(out.features.append_rows(1), d);
   for (const Vec3& span : s.spans) row = put_vector(row, span);
   for (const Vec3& span : r.spans) row = put_vector(row, span);
+  const Vec3 n_s = current_normal(sender, sender_face);
   row = put_direction(row, current_normal(receiver, receiver_face));
-  row = put_direction(row, current_normal(sender, sender_face));
+  row = put_direction(row, n_s);
   // Resting contact (|d| = 5 mm, Bullet's margin) and a body let go a few millimetres higher are
   // ~0.1σ apart in |d| above (σ ≈ 3 cm); on a logarithmic scale they are ~0.5 apart.
   if (const double scale = config.distance_log_scale; scale > 0.0)
-    *row = static_cast<float>(std::log1p(d.norm() / scale));
+    *row++ = static_cast<float>(std::log1p(d.norm() / scale));
+  if (config.contact_motion) {
+    const Vec3 u =
+        point_motion(receiver, receiver_face, p_r) - point_motion(sender, sender_face, p_s);
+    row = put_vector(row, u);
+    *row++ = static_cast<float>(u.dot(n_s));
+  }
   for (int k = 0; k < 3; ++k) {
     out.senders.push_back(sender_first + s.nodes[k]);
     out.receivers.push_back(receiver_first + r.nodes[k]);

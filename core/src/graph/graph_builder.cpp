@@ -96,8 +96,10 @@ void GraphBuilder::gather_objects(const Scene& scene, int scene_index) {
 }
 
 PosedMesh GraphBuilder::current_pose(const SceneObject& object) const {
-  const size_t current_row = static_cast<size_t>(config_.history) * object.mesh->num_vertices();
-  return {object.mesh, object.positions.data() + current_row * 3, object.kinematic};
+  const size_t v = object.mesh->num_vertices();
+  const size_t current_row = static_cast<size_t>(config_.history) * v;
+  const double* current = object.positions.data() + current_row * 3;
+  return {object.mesh, current, object.kinematic, current - v * 3};
 }
 
 void GraphBuilder::select_pairs(const std::span<const ObjectPair>* candidates) {

@@ -59,6 +59,7 @@ void write_config(H5::Group group, const ModelConfig& c) {
   write_attribute(group, "face_span_limit", c.graph.face_span_limit);
   write_attribute(group, "velocity_log_scale", c.graph.velocity_log_scale);
   write_attribute(group, "distance_log_scale", c.graph.distance_log_scale);
+  write_attribute(group, "contact_motion", static_cast<long long>(c.graph.contact_motion));
   write_attribute(group, "noise", std::string(c.noise == NoiseKind::kRigid ? "rigid" : "vertex"));
   write_attribute(group, "noise_correction", c.noise_correction);
   write_attribute(group, "random_yaw", static_cast<long long>(c.random_yaw));
@@ -105,6 +106,7 @@ ModelConfig read_config(const H5::Group& group) {
   c.graph.mesh_edges = flag("mesh_edges", true);
   c.graph.static_internal_edges = flag("static_internal_edges", true);
   c.graph.log_mass = flag("log_mass", false);
+  c.graph.contact_motion = flag("contact_motion", false);
   if (group.attrExists("face_span_limit")) {
     c.graph.face_span_limit = read_double(group, "face_span_limit");
   }

@@ -92,6 +92,8 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        plain<double>([](TrainingConfig & c) -> auto& { return c.model.graph.velocity_log_scale; })},
       {"distance_log_scale",
        plain<double>([](TrainingConfig & c) -> auto& { return c.model.graph.distance_log_scale; })},
+      {"contact_motion",
+       plain<bool>([](TrainingConfig & c) -> auto& { return c.model.graph.contact_motion; })},
       {"noise_std", plain<double>([](TrainingConfig & c) -> auto& { return c.model.noise_std; })},
       {"noise",
        named_enum<NoiseKind>([](TrainingConfig & c) -> auto& { return c.model.noise; },

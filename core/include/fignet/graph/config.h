@@ -43,6 +43,13 @@ struct GraphConfig {
   // |d_rs| is normalised by a σ set by the collision radius (3.2 cm in a MOVi-A model), where a
   // body resting 5 mm above the floor and one held 4 mm higher differ by 0.13σ.
   double distance_log_scale = 0.0;
+  // Face–face edges also carry the motion of the receiver's closest point relative to the
+  // sender's over the last frame, u = Δp_r − Δp_s (each interpolated from its face's vertex
+  // displacements, exact for rigid motion), as [u, |u|, u·n_s]: u·n_s < 0 is the approach speed
+  // along the sender's normal. With |d_rs| it tells when within the next frame two faces meet,
+  // which node velocities give only through six vertices' latents; the one-step error of
+  // impacts (4× moving contact's, and too soft) comes from that instant.
+  bool contact_motion = false;
 
   // Throws ConfigError naming the first invalid field and its value.
   void validate() const;
@@ -56,7 +63,7 @@ struct FeatureSizes {
   int mesh_edge;    // [d, |d|, d_rest, |d_rest|] = 8; also object->mesh and mesh->object
   int world_edge;   // [d, |d|] = 4 (node–node collision edges)
   int face_edge;    // [d_rs, 3 sender spans, 3 receiver spans] with norms, n_r, n_s = 34
-                    // (+ 1 logarithm of |d_rs|)
+                    // (+ 1 logarithm of |d_rs|, + 5 contact motion)
 };
 FeatureSizes feature_sizes(const GraphConfig& config);
 

@@ -16,8 +16,12 @@ struct PosedMesh {
   const TriangleMesh* mesh = nullptr;
   const double* positions = nullptr;  // num_vertices x 3, row-major, world frame
   bool kinematic = false;
+  // The same vertices one frame earlier, where the graph's features need their motion (null:
+  // unknown, read as still).
+  const double* previous = nullptr;
 
   Eigen::Map<const Points> vertices() const { return {positions, mesh->num_vertices(), 3}; }
+  Eigen::Map<const Points> previous_vertices() const { return {previous, mesh->num_vertices(), 3}; }
 };
 
 struct ObjectPair {
