@@ -153,7 +153,8 @@ void print_regimes(const std::vector<Row>& rows) {
     fmt::print(
         "{:<34} impacts: {:.0f} object-steps, {:.0f} ({:.1f}%) with no collision edge in "
         "their input\n",
-        "", t.impacts, t.unseen_impacts, 100.0 * t.unseen_impacts / std::max(t.impacts, 1.0));
+        "", t.impact_errors.samples, t.unseen_impacts,
+        100.0 * t.unseen_impacts / std::max(t.impact_errors.samples, 1.0));
   }
 }
 
@@ -201,7 +202,7 @@ nlohmann::json to_json(const Row& row) {
       regimes[std::string(regime_name(static_cast<Regime>(k)))] = group(row.one_step->regimes[k]);
     }
     regimes["impact steps"] = group(row.one_step->impact_errors);
-    regimes["impacts"] = row.one_step->impacts;
+    regimes["impacts"] = row.one_step->impact_errors.samples;
     regimes["unseen_impacts"] = row.one_step->unseen_impacts;
   }
   return {{"name", row.name},

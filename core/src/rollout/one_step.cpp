@@ -37,7 +37,6 @@ void RegimeTotals::add(const RegimeTotals& other) {
 OneStepTotals& OneStepTotals::operator+=(const OneStepTotals& other) {
   for (int r = 0; r < kRegimes; ++r) regimes[r].add(other.regimes[r]);
   impact_errors.add(other.impact_errors);
-  impacts += other.impacts;
   unseen_impacts += other.unseen_impacts;
   return *this;
 }
@@ -57,17 +56,17 @@ RegimeTotals regime_from(const double* v) {
 
 }  // namespace
 
-// [each regime's 7 sums, the impacts' 7 sums, impacts, unseen impacts].
+// [each regime's 7 sums, the impacts' 7 sums, unseen impacts].
 std::vector<double> OneStepTotals::serialize() const {
   std::vector<double> out;
   for (const RegimeTotals& r : regimes) append(r, out);
   append(impact_errors, out);
-  out.insert(out.end(), {impacts, unseen_impacts});
+  out.push_back(unseen_impacts);
   return out;
 }
 
 OneStepTotals OneStepTotals::deserialize(std::span<const double> values) {
-  constexpr size_t kSize = kRegimeValues * (kRegimes + 1) + 2;
+  constexpr size_t kSize = kRegimeValues * (kRegimes + 1) + 1;
   if (values.size() != kSize) {
     throw ConfigError("OneStepTotals: expected " + std::to_string(kSize) + " values, got " +
                       std::to_string(values.size()));
@@ -77,7 +76,6 @@ OneStepTotals OneStepTotals::deserialize(std::span<const double> values) {
     totals.regimes[r] = regime_from(values.data() + kRegimeValues * r);
   }
   totals.impact_errors = regime_from(values.data() + kRegimeValues * kRegimes);
-  totals.impacts = values[kSize - 2];
   totals.unseen_impacts = values[kSize - 1];
   return totals;
 }
@@ -129,10 +127,7 @@ OneStepTotals one_step_totals(AccelerationPredictor& predictor, const GraphConfi
             (after.position - 2.0 * now.position + before.position) / (dt * dt);
         const bool edge = interacting[o] != 0;
         const bool impact = (acceleration - truth.gravity).norm() > options.impact_g * g;
-        if (impact) {
-          totals.impacts += 1;
-          if (!edge) totals.unseen_impacts += 1;
-        }
+        if (impact && !edge) totals.unseen_impacts += 1;
         const Regime regime =
             !edge ? Regime::kFreeFlight
             : speed < options.rest_speed && angular_speed < options.rest_angular_speed

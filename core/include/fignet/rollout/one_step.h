@@ -49,10 +49,11 @@ struct RegimeTotals {
 
 struct OneStepTotals {
   std::array<RegimeTotals, kRegimes> regimes{};
-  double impacts = 0, unseen_impacts = 0;  // object-steps
-  // The impacts' errors (every regime's object-steps whose truth is an impact): one impact's
-  // error becomes a velocity error that a rollout carries from then on.
+  // The impacts' errors (every regime's object-steps whose truth is an impact; their count is
+  // impact_errors.samples): one impact's error becomes a velocity error that a rollout carries
+  // from then on.
   RegimeTotals impact_errors;
+  double unseen_impacts = 0;  // object-steps of those with no collision edge in their input
   OneStepTotals& operator+=(const OneStepTotals& other);
   std::vector<double> serialize() const;
   static OneStepTotals deserialize(std::span<const double> values);
