@@ -97,28 +97,55 @@ TEST_P(Gemm, EmptyInnerDimensionGivesZerosOrLeavesTheSum) {
   gemm(RowMatrixXf(0, 5), Transpose::kNo, random_matrix(5, 3, 2), Transpose::kNo, empty, false);
 }
 
+// gemm(op_a(a)·op_b(b)) at 1 to 4 threads (Eigen's setting), for both op_b and with and
+// without accumulating into `start`: within `tolerance` of the double product at one thread, and
+// the same bits at every other count.
+void expect_same_bits_for_any_thread_count(const RowMatrixXf& a, Transpose op_a,
+                                           const RowMatrixXf& b, const RowMatrixXf& start,
+                                           double tolerance) {
+  const RowMatrixXf bt = b.transpose();
+  auto run = [&](int threads, Transpose op_b, bool accumulate) {
+    Eigen::setNbThreads(threads);
+    RowMatrixXf c = start;
+    gemm(a, op_a, op_b == Transpose::kNo ? b : bt, op_b, c, accumulate);
+    Eigen::setNbThreads(0);
+    return c;
+  };
+  const MatrixXdRow exact = op_a == Transpose::kNo
+                                ? MatrixXdRow(a.cast<double>() * b.cast<double>())
+                                : MatrixXdRow(a.cast<double>().transpose() * b.cast<double>());
+  for (Transpose op_b : {Transpose::kNo, Transpose::kYes}) {
+    for (bool accumulate : {false, true}) {
+      SCOPED_TRACE(::testing::Message() << "op_b transposed " << (op_b == Transpose::kYes)
+                                        << ", accumulate " << accumulate);
+      const RowMatrixXf one = run(1, op_b, accumulate);
+      const MatrixXdRow expected = accumulate ? MatrixXdRow(exact + start.cast<double>()) : exact;
+      EXPECT_LT((one.cast<double>() - expected).cwiseAbs().maxCoeff(), tolerance);
+      for (int threads = 2; threads <= 4; ++threads) {
+        EXPECT_EQ(run(threads, op_b, accumulate), one) << threads << " threads";
+      }
+    }
+  }
+}
+
 // Weight gradients (aᵀ·b) sum over thousands of rows; threads share that sum, and the result must
 // be the same bits for any thread count (bit-exact resume on another machine's core count).
 TEST_P(Gemm, SumsOverRowsGiveTheSameBitsForAnyThreadCount) {
   const EngineScope scope(GetParam());
-  const RowMatrixXf a = random_matrix(2500, 64, 1), b = random_matrix(2500, 48, 2);
-  const RowMatrixXf bt = b.transpose(), start = random_matrix(64, 48, 3);
-  auto run = [&](int threads, Transpose tb, bool accumulate) {
-    Eigen::setNbThreads(threads);
-    RowMatrixXf c = start;
-    gemm(a, Transpose::kYes, tb == Transpose::kNo ? b : bt, tb, c, accumulate);
-    Eigen::setNbThreads(0);
-    return c;
-  };
-  const MatrixXdRow exact = a.cast<double>().transpose() * b.cast<double>();
-  for (Transpose tb : {Transpose::kNo, Transpose::kYes}) {
-    for (bool accumulate : {false, true}) {
-      const RowMatrixXf one = run(1, tb, accumulate);
-      const MatrixXdRow expected = accumulate ? MatrixXdRow(exact + start.cast<double>()) : exact;
-      EXPECT_LT((one.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-5 * 2500);
-      EXPECT_EQ(run(2, tb, accumulate), one);
-      EXPECT_EQ(run(3, tb, accumulate), one);
-    }
+  expect_same_bits_for_any_thread_count(random_matrix(2500, 64, 1), Transpose::kYes,
+                                        random_matrix(2500, 48, 2), random_matrix(64, 48, 3),
+                                        1e-5 * 2500);
+}
+
+// Row products (a·b) of a scene's thousands of rows are shared among threads too: each row's
+// bits must not depend on how many (oneDNN's own threading on avx2 kernels changes them).
+TEST_P(Gemm, RowProductsGiveTheSameBitsForAnyThreadCount) {
+  const EngineScope scope(GetParam());
+  for (const Eigen::Index k : {64, 384}) {
+    SCOPED_TRACE(::testing::Message() << "k = " << k);
+    expect_same_bits_for_any_thread_count(random_matrix(2401, k, 4), Transpose::kNo,
+                                          random_matrix(k, 128, 5), random_matrix(2401, 128, 6),
+                                          1e-5 * k);
   }
 }
 

@@ -162,6 +162,30 @@ void weight_gradient(GemmEngine engine, const ConstMatrixRef& a, const ConstMatr
   }
 }
 
+// Rows of a block of a row product (below): enough for a one-thread product at full speed, few
+// enough that a scene's graph of a few thousand rows still shares out among threads.
+constexpr Eigen::Index kProductBlockRows = 256;
+
+// c (+)= a·op_b(b), each row of c a product of its own. A threaded sgemm splits the work in a way
+// that depends on the thread count, and on some kernels (oneDNN's avx2 ones) so do the rows' last
+// bits. Instead the rows are cut into blocks of kProductBlockRows, each block a one-thread product,
+// and the blocks shared among the threads: a row's bits depend only on its block, never on the
+// thread count.
+void row_products(GemmEngine engine, const ConstMatrixRef& a, const ConstMatrixRef& b,
+                  Transpose op_b, MatrixRef c, bool accumulate) {
+  const Eigen::Index m = c.rows();
+  const Eigen::Index blocks = (m + kProductBlockRows - 1) / kProductBlockRows;
+  // Inside a team the blocks stay on this thread: its products are single-threaded already.
+  const int threads = omp_in_parallel() ? 1 : Eigen::nbThreads();
+  detail::parallel_for(static_cast<int>(blocks), threads, detail::Schedule::kContiguous,
+                       [&](int block) {
+                         const Eigen::Index first = block * kProductBlockRows;
+                         const Eigen::Index rows = std::min(kProductBlockRows, m - first);
+                         gemm_one_thread(engine, a.middleRows(first, rows), Transpose::kNo, b, op_b,
+                                         c.middleRows(first, rows), accumulate);
+                       });
+}
+
 #ifdef FIGNET_WITH_ONEDNN
 const char* isa_name(dnnl_cpu_isa_t isa) {
   switch (isa) {
@@ -205,15 +229,7 @@ void gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b, Tran
     weight_gradient(engine, a, b, op_b, c, accumulate);
     return;
   }
-#ifdef FIGNET_WITH_ONEDNN
-  if (engine == GemmEngine::kOneDnn) {
-    // Threads as Eigen's setting says, as Eigen's products would.
-    check_onednn(onednn_gemm(a, op_a, b, op_b, c, accumulate, Eigen::nbThreads()), c.rows(), k,
-                 c.cols());
-    return;
-  }
-#endif
-  eigen_gemm(a, op_a, b, op_b, c, accumulate);
+  row_products(engine, a, b, op_b, c, accumulate);
 }
 
 GemmEngine gemm_engine() {

@@ -7,9 +7,10 @@
 //     preset); the fallback of a build without oneDNN.
 // Both use the threads Eigen::nbThreads() gives (Eigen::setNbThreads, OpenMP's default otherwise)
 // and run single-threaded inside an OpenMP parallel region. Results of one engine depend on the
-// shape and the processor, not on the thread count (oneDNN's op_a = kYes products, the sums
-// over a batch's rows, are cut into fixed blocks of rows shared among the threads and added in
-// block order for that).
+// shape and the processor, not on the thread count: neither engine's own threading promises that
+// (oneDNN's avx2 kernels change the last bits with it), so gemm() does the threading itself. Row
+// products are cut into fixed blocks of rows, each a one-thread product; the sums over a batch's
+// rows (op_a = kYes) into fixed blocks whose one-thread partials are added in block order.
 #pragma once
 
 #include <string>
