@@ -527,8 +527,9 @@ TEST(FIGNetWorld, FreeFlightLeavesBodiesInContactAsTheNetworkMovesThem) {
     for (int step = 0; step < 6; ++step) {
       scene.fixture.step();
       for (btRigidBody* body : resting) {
-        positions.push_back(scene.fixture.world.precise_pose(*body).position);
-        orientations.push_back(scene.fixture.world.precise_pose(*body).orientation.coeffs());
+        const Pose pose = scene.fixture.world.precise_pose(*body);
+        positions.push_back(pose.position);
+        orientations.push_back(pose.orientation.coeffs());
       }
       const FIGNetStepStats& stats = scene.fixture.world.last_step_stats();
       EXPECT_EQ(stats.simulated_bodies, free_flight ? 4 : 4 + with_flyer);

@@ -67,28 +67,21 @@ void eigen_gemm_one_thread(const ConstMatrixRef& a, Transpose op_a, const ConstM
 }
 
 #ifdef FIGNET_WITH_ONEDNN
-// Runs `body` with OpenMP's thread setting at `threads`, restored afterwards (oneDNN's OpenMP
-// runtime takes omp_get_max_threads()).
-template <typename Body>
-void with_omp_threads(int threads, Body&& body) {
-  const int before = omp_get_max_threads();
-  if (threads != before) omp_set_num_threads(threads);
-  body();
-  if (threads != before) omp_set_num_threads(before);
-}
-
-// oneDNN's sgemm on `threads` threads; returns its status.
-dnnl_status_t onednn_gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b,
-                          Transpose op_b, MatrixRef c, bool accumulate, int threads) {
+// oneDNN's sgemm on the calling thread alone; returns its status.
+dnnl_status_t onednn_gemm_one_thread(const ConstMatrixRef& a, Transpose op_a,
+                                     const ConstMatrixRef& b, Transpose op_b, MatrixRef c,
+                                     bool accumulate) {
   const Eigen::Index m = c.rows(), n = c.cols();
   const Eigen::Index k = op_a == Transpose::kNo ? a.cols() : a.rows();
-  dnnl_status_t status = dnnl_success;
-  with_omp_threads(threads, [&] {
-    // Row-major throughout: oneDNN's sgemm takes row-major operands and leading dimensions.
-    status = dnnl_sgemm(op_a == Transpose::kNo ? 'N' : 'T', op_b == Transpose::kNo ? 'N' : 'T', m,
-                        n, k, 1.0f, a.data(), a.outerStride(), b.data(), b.outerStride(),
-                        accumulate ? 1.0f : 0.0f, c.data(), c.outerStride());
-  });
+  // oneDNN's OpenMP runtime takes omp_get_max_threads(): one for this call, restored after.
+  const int threads_before = omp_get_max_threads();
+  if (threads_before != 1) omp_set_num_threads(1);
+  // Row-major throughout: oneDNN's sgemm takes row-major operands and leading dimensions.
+  const dnnl_status_t status =
+      dnnl_sgemm(op_a == Transpose::kNo ? 'N' : 'T', op_b == Transpose::kNo ? 'N' : 'T', m, n, k,
+                 1.0f, a.data(), a.outerStride(), b.data(), b.outerStride(),
+                 accumulate ? 1.0f : 0.0f, c.data(), c.outerStride());
+  if (threads_before != 1) omp_set_num_threads(threads_before);
   return status;
 }
 
@@ -101,12 +94,18 @@ void check_onednn(dnnl_status_t status, Eigen::Index m, Eigen::Index k, Eigen::I
 }
 #endif
 
+// Threads that share the blocks of a product: Eigen's setting, or one inside an OpenMP team
+// (whose products are single-threaded already).
+int threads_for_blocks() {
+  return omp_in_parallel() ? 1 : Eigen::nbThreads();
+}
+
 // The engine's product on the calling thread alone.
 void gemm_one_thread(GemmEngine engine, const ConstMatrixRef& a, Transpose op_a,
                      const ConstMatrixRef& b, Transpose op_b, MatrixRef c, bool accumulate) {
 #ifdef FIGNET_WITH_ONEDNN
   if (engine == GemmEngine::kOneDnn) {
-    check_onednn(onednn_gemm(a, op_a, b, op_b, c, accumulate, 1), c.rows(),
+    check_onednn(onednn_gemm_one_thread(a, op_a, b, op_b, c, accumulate), c.rows(),
                  op_a == Transpose::kNo ? a.cols() : a.rows(), c.cols());
     return;
   }
@@ -148,9 +147,8 @@ void weight_gradient(GemmEngine engine, const ConstMatrixRef& a, const ConstMatr
                                        : ConstMatrixRef(b.middleCols(first, rows));
     gemm_one_thread(engine, a.middleRows(first, rows), Transpose::kYes, b_block, op_b, out, false);
   };
-  // Inside a team the blocks stay on this thread: its products are single-threaded already.
-  const int threads = omp_in_parallel() ? 1 : Eigen::nbThreads();
-  detail::parallel_for(static_cast<int>(blocks), threads, detail::Schedule::kContiguous, run_block);
+  detail::parallel_for(static_cast<int>(blocks), threads_for_blocks(),
+                       detail::Schedule::kContiguous, run_block);
   // c = (c or 0) + partial_0 + partial_1 + ..., in that order for every element.
   for (Eigen::Index r = 0; r < m; ++r) {
     float* row = c.row(r).data();
@@ -175,10 +173,8 @@ void row_products(GemmEngine engine, const ConstMatrixRef& a, const ConstMatrixR
                   Transpose op_b, MatrixRef c, bool accumulate) {
   const Eigen::Index m = c.rows();
   const Eigen::Index blocks = (m + kProductBlockRows - 1) / kProductBlockRows;
-  // Inside a team the blocks stay on this thread: its products are single-threaded already.
-  const int threads = omp_in_parallel() ? 1 : Eigen::nbThreads();
-  detail::parallel_for(static_cast<int>(blocks), threads, detail::Schedule::kContiguous,
-                       [&](int block) {
+  detail::parallel_for(static_cast<int>(blocks), threads_for_blocks(),
+                       detail::Schedule::kContiguous, [&](int block) {
                          const Eigen::Index first = block * kProductBlockRows;
                          const Eigen::Index rows = std::min(kProductBlockRows, m - first);
                          gemm_one_thread(engine, a.middleRows(first, rows), Transpose::kNo, b, op_b,
