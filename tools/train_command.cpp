@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -73,11 +74,27 @@ int most_mesh_vertices(const std::vector<Trajectory>& data) {
   return most;
 }
 
+// The lightest and heaviest dynamic body of the data (metadata like the above; under mpirun the
+// share process 0 read, whose 700+ trajectories hold MOVi's whole range).
+void record_masses(const std::vector<Trajectory>& data, ModelConfig& model) {
+  double lightest = INFINITY, heaviest = 0.0;
+  for (const Trajectory& t : data)
+    for (const TrajectoryObject& object : t.objects) {
+      if (object.kinematic || !(object.properties.mass > 0.0)) continue;
+      lightest = std::min(lightest, object.properties.mass);
+      heaviest = std::max(heaviest, object.properties.mass);
+    }
+  if (heaviest == 0.0) return;
+  model.min_mass = lightest;
+  model.max_mass = heaviest;
+}
+
 // Time step and gravity come from the data, which must agree on them.
 void adopt_physics(const std::vector<Trajectory>& data, ModelConfig& model) {
   model.time_step = data.front().time_step;
   model.gravity = data.front().gravity;
   model.mesh_vertices = most_mesh_vertices(data);
+  record_masses(data, model);
   for (size_t i = 0; i < data.size(); ++i) {
     if (data[i].time_step != model.time_step || data[i].gravity != model.gravity) {
       throw ConfigError(fmt::format(
@@ -154,6 +171,7 @@ void run_train(const TrainArgs& args) {
     const std::int64_t steps = config.steps;
     config.model = checkpoint.model->config();
     if (config.model.mesh_vertices == 0) config.model.mesh_vertices = most_mesh_vertices(data);
+    if (config.model.max_mass == 0.0) record_masses(data, config.model);
     config.trainer = checkpoint.trainer_config;
     resumed_batch_size = config.trainer.batch_size;
     // The run's own length unless --steps says otherwise.

@@ -952,12 +952,13 @@ FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
                                          btCollisionConfiguration* configuration,
                                          std::shared_ptr<const Model> model,
                                          const FIGNetWorldOptions& options)
-    : FIGNetDynamicsWorld(
-          dispatcher, broadphase, solver, configuration,
-          std::make_unique<ModelPredictor>(
-              model, PredictionOptions{.threads = options.threads, .turns = options.turns}),
-          model->config().graph, model->config().time_step, model->config().gravity,
-          with_model_budget(options, model->config())) {}
+    : FIGNetDynamicsWorld(dispatcher, broadphase, solver, configuration,
+                          std::make_unique<ModelPredictor>(
+                              model, PredictionOptions{.threads = options.threads,
+                                                       .turns = options.turns,
+                                                       .fit_masses = options.fit_masses}),
+                          model->config().graph, model->config().time_step, model->config().gravity,
+                          with_model_budget(options, model->config())) {}
 
 FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
                                          btBroadphaseInterface* broadphase,

@@ -30,6 +30,8 @@ py::dict config_of(const Model& model) {
   out["time_step"] = model.config().time_step;
   out["gravity"] = vec3_array(model.config().gravity);
   out["mesh_vertices"] = model.config().mesh_vertices;
+  out["min_mass"] = model.config().min_mass;  // the training data's masses, kg (0: unknown)
+  out["max_mass"] = model.config().max_mass;
   return out;
 }
 

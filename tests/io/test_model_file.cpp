@@ -27,6 +27,8 @@ class ModelFile : public testing::TempFolderTest {
     config.graph.velocity_log_scale = 1e-4;
     config.graph.distance_log_scale = 2e-3;
     config.graph.contact_motion = true;
+    config.min_mass = 1.6;
+    config.max_mass = 59.0;
     Model fresh(config);
     Normalizers normalizers = fresh.normalizers();
     RowMatrixXf rows = RowMatrixXf::Random(10, normalizers.mesh_node.size());
@@ -67,6 +69,8 @@ TEST_F(ModelFile, SaveThenLoadIsBitExact) {
   EXPECT_EQ(loaded.config().graph.velocity_log_scale, 1e-4);
   EXPECT_EQ(loaded.config().graph.distance_log_scale, 2e-3);
   EXPECT_TRUE(loaded.config().graph.contact_motion);
+  EXPECT_EQ(loaded.config().min_mass, 1.6);
+  EXPECT_EQ(loaded.config().max_mass, 59.0);
   EXPECT_EQ(loaded.normalizers().face_edge.size(), 34 + 1 + 5);  // the logarithm, the motion
   EXPECT_EQ(loaded.normalizers().mesh_node.sum(), model_->normalizers().mesh_node.sum());
   EXPECT_EQ(loaded.normalizers().mesh_node.sum_squares(),

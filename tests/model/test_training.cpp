@@ -460,6 +460,66 @@ TEST(ModelPredictor, TurnAveragingCancelsAConstantHorizontalBias) {
   }
 }
 
+TEST(MassFit, TheFactorNearestOneThatFitsTheSceneWithinTheTrainingMasses) {
+  Scene scene;
+  for (const auto& [mass, kinematic] : {std::pair(2.0, false), {8.0, false}, {0.0, true}}) {
+    scene.objects.emplace_back().properties.mass = mass;
+    scene.objects.back().kinematic = kinematic;
+  }
+  scene.objects.emplace_back().properties.mass = 1e6;  // a kinematic body's mass counts for
+  scene.objects.back().kinematic = true;               // nothing: it cannot be moved anyway
+  EXPECT_EQ(mass_fit_factor(scene, 1.0, 10.0), 1.0);   // within: untouched
+  EXPECT_EQ(mass_fit_factor(scene, 2.0, 8.0), 1.0);
+  EXPECT_DOUBLE_EQ(mass_fit_factor(scene, 100.0, 1000.0), 50.0);   // the lightest lifted to 100
+  EXPECT_DOUBLE_EQ(mass_fit_factor(scene, 0.01, 0.1), 0.1 / 8.0);  // the heaviest down to 0.1
+  // A span of 4 into one of 2: the geometric means meet, sqrt(2·8)·f = sqrt(1·2).
+  EXPECT_DOUBLE_EQ(mass_fit_factor(scene, 1.0, 2.0), std::sqrt(2.0) / 4.0);
+  EXPECT_EQ(mass_fit_factor(scene, 0.0, 0.0), 1.0);  // a model that does not know its masses
+  Scene kinematic_only;
+  kinematic_only.objects.emplace_back().kinematic = true;
+  EXPECT_EQ(mass_fit_factor(kinematic_only, 100.0, 1000.0), 1.0);
+}
+
+TEST(ModelPredictor, MassesOutsideTheTrainingDataAreFittedByOneCommonFactor) {
+  // Bodies of 1, 2, 4 and 5 kg (and kinematic ones) for a model that knows 1-10 kg: scaled by
+  // 1000 or 100,000 the network sees the scene doubled (heaviest 10 kg) both times.
+  auto fixture = testing::make_random_scene(13, 5, 0.6);
+  const auto model_of = [&](double min_mass, double max_mass) {
+    const auto random = random_model(fixture.scene);
+    ModelConfig config = random->config();
+    config.min_mass = min_mass;
+    config.max_mass = max_mass;
+    return std::make_shared<const Model>(config, random->parameters(), random->normalizers());
+  };
+  const auto scaled = [&](double factor) {
+    Scene scene = fixture.scene;
+    for (SceneObject& object : scene.objects) object.properties.mass *= factor;
+    return scene;
+  };
+  const auto prediction = [](ModelPredictor&& predictor, const Scene& scene) {
+    Points accelerations;
+    predictor.predict(scene, accelerations);
+    return accelerations;
+  };
+  const auto knowing = model_of(1.0, 10.0);
+  const Points doubled = prediction(ModelPredictor(knowing), scaled(2.0));
+  const double size = doubled.cwiseAbs().maxCoeff();
+  for (const double factor : {1e3, 1e5}) {
+    const Points fitted = prediction(ModelPredictor(knowing), scaled(factor));
+    EXPECT_LT((fitted - doubled).cwiseAbs().maxCoeff(), 1e-6 * size) << factor;
+    const Points unfitted =
+        prediction(ModelPredictor(knowing, {.fit_masses = false}), scaled(factor));
+    EXPECT_GT((unfitted - doubled).cwiseAbs().maxCoeff(), 1e-2 * size) << factor;
+  }
+  // Within the training masses, or for a model without them, the scene is the network's as is.
+  const Points original = prediction(ModelPredictor(knowing, {.fit_masses = false}), fixture.scene);
+  EXPECT_EQ(prediction(ModelPredictor(knowing), fixture.scene), original);
+  EXPECT_EQ(prediction(ModelPredictor(model_of(0.0, 0.0)), fixture.scene), original);
+  EXPECT_GT(
+      (prediction(ModelPredictor(model_of(0.0, 0.0)), scaled(1e3)) - doubled).cwiseAbs().maxCoeff(),
+      1e-2 * size);
+}
+
 TEST(ModelPredictor, RejectsTurnsBelowOne) {
   auto fixture = testing::make_random_scene(7, 2, 0.6);
   auto model = random_model(fixture.scene);

@@ -90,6 +90,12 @@ TEST(TrainingConfig, BadInputNamesTheField) {
   config.apply_setting("noise_correction=1.5");
   EXPECT_NE(error_of([&] { config.validate(); }).find("noise_correction = 1.5 (must be in [0, 1])"),
             std::string::npos);
+  config.apply_setting("noise_correction=0.5");
+  config.model.min_mass = 2.0;  // the training masses are both known or both unknown (0)
+  EXPECT_NE(error_of([&] { config.validate(); }).find("max_mass = 0 (must be >= min_mass)"),
+            std::string::npos);
+  config.model.max_mass = 3.0;
+  EXPECT_NO_THROW(config.validate());
 }
 
 // fignet train lets decay_steps follow --steps unless a --set or --config named it.

@@ -43,6 +43,8 @@ void write_config(H5::Group group, const ModelConfig& c) {
     write_attribute(group, fmt::format("gravity_{}", "xyz"[i]), c.gravity[i]);
   write_attribute(group, "seed", static_cast<long long>(c.seed));
   write_attribute(group, "mesh_vertices", static_cast<long long>(c.mesh_vertices));
+  write_attribute(group, "min_mass", c.min_mass);
+  write_attribute(group, "max_mass", c.max_mass);
   write_attribute(group, "collision_radius", c.graph.collision_radius);
   write_attribute(group, "history", static_cast<long long>(c.graph.history));
   write_attribute(group, "object_nodes", static_cast<long long>(c.graph.object_nodes));
@@ -79,6 +81,10 @@ ModelConfig read_config(const H5::Group& group) {
   c.seed = static_cast<std::uint64_t>(read_integer(group, "seed"));
   if (group.attrExists("mesh_vertices")) {
     c.mesh_vertices = static_cast<int>(read_integer(group, "mesh_vertices"));
+  }
+  if (group.attrExists("min_mass") && group.attrExists("max_mass")) {
+    c.min_mass = read_double(group, "min_mass");
+    c.max_mass = read_double(group, "max_mass");
   }
   c.graph.collision_radius = read_double(group, "collision_radius");
   c.graph.history = static_cast<int>(read_integer(group, "history"));

@@ -44,6 +44,13 @@ void ModelConfig::validate() const {
     fail("normalizer_max_accumulations", normalizer_max_accumulations, "must be >= 1");
   }
   if (mesh_vertices < 0) fail("mesh_vertices", mesh_vertices, "must be >= 0");
+  if (!(min_mass >= 0.0) || !std::isfinite(min_mass)) fail("min_mass", min_mass, "must be >= 0");
+  if (!(max_mass >= min_mass) || !std::isfinite(max_mass)) {
+    fail("max_mass", max_mass, "must be >= min_mass");
+  }
+  if ((min_mass == 0.0) != (max_mass == 0.0)) {
+    fail("min_mass", min_mass, "and max_mass must both be 0 (unknown) or both be > 0");
+  }
   if (!(time_step > 0.0) || !std::isfinite(time_step)) fail("time_step", time_step, "must be > 0");
   if (!gravity.allFinite()) fail("gravity", "non-finite", "must be finite");
 }

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <numbers>
 
 #include "fignet/error.h"
@@ -17,6 +19,23 @@ Eigen::Index count_nodes(const Scene& scene) {
 }
 
 }  // namespace
+
+double mass_fit_factor(const Scene& scene, double min_mass, double max_mass) {
+  if (!(min_mass > 0.0 && max_mass >= min_mass)) return 1.0;
+  // The scene's dynamic masses as a span of logarithms.
+  double lightest = INFINITY, heaviest = 0.0;
+  for (const SceneObject& object : scene.objects) {
+    if (object.kinematic || !(object.properties.mass > 0.0)) continue;
+    lightest = std::min(lightest, object.properties.mass);
+    heaviest = std::max(heaviest, object.properties.mass);
+  }
+  if (!(heaviest > 0.0) || !std::isfinite(heaviest)) return 1.0;
+  const double low = std::log(min_mass) - std::log(lightest);   // least shift that lifts it in
+  const double high = std::log(max_mass) - std::log(heaviest);  // most shift that keeps it in
+  // The shift nearest 0 that fits the span inside; centred on the range when it does not fit.
+  const double shift = low <= high ? std::clamp(0.0, low, high) : 0.5 * (low + high);
+  return shift == 0.0 ? 1.0 : std::exp(shift);
+}
 
 void PredictionOptions::validate() const {
   if (threads < 0) {
@@ -54,9 +73,21 @@ void ModelPredictor::predict_averaged(const Scene& scene, Build&& build, Points&
   if (options_.turns > 1) accelerations = (accelerations + turned_sum_) / options_.turns;
 }
 
+const Scene& ModelPredictor::with_fitted_masses(const Scene& scene) {
+  if (!options_.fit_masses) return scene;
+  const ModelConfig& config = model_->config();
+  const double factor = mass_fit_factor(scene, config.min_mass, config.max_mass);
+  if (factor == 1.0) return scene;
+  mass_fitted_ = scene;  // copy-assigned: a steady-state step reuses the last one's buffers
+  for (SceneObject& object : mass_fitted_.objects) {
+    if (!object.kinematic) object.properties.mass *= factor;
+  }
+  return mass_fitted_;
+}
+
 void ModelPredictor::predict(const Scene& scene, Points& accelerations) {
   predict_averaged(
-      scene, [&](const Scene& s) { builder_.build(s, graph_); }, accelerations);
+      with_fitted_masses(scene), [&](const Scene& s) { builder_.build(s, graph_); }, accelerations);
 }
 
 void ModelPredictor::predict_with_candidates(const Scene& scene,
@@ -64,7 +95,8 @@ void ModelPredictor::predict_with_candidates(const Scene& scene,
                                              Points& accelerations) {
   // A turn about the vertical moves no object into or out of a pair: the candidates stand.
   predict_averaged(
-      scene, [&](const Scene& s) { builder_.build_with_candidates(s, candidates, graph_); },
+      with_fitted_masses(scene),
+      [&](const Scene& s) { builder_.build_with_candidates(s, candidates, graph_); },
       accelerations);
 }
 

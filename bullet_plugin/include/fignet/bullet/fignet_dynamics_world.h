@@ -92,6 +92,9 @@ struct FIGNetWorldOptions {
   // PredictionOptions::turns): cancels the model's own sideways push on resting bodies, at
   // `turns` times the network's cost. 1: off. Only for worlds built from a model.
   int turns = 1;
+  // The network sees the scene's masses times the common factor that brings them within its
+  // training data's (PredictionOptions::fit_masses; only for worlds built from a model).
+  bool fit_masses = true;
 };
 
 // What the last internal step simulated and what it cost.

@@ -30,7 +30,7 @@ struct GraphConfig {
   // Mesh and object–mesh edges inside kinematic objects (the floor's 80 m edges among them);
   // their latents cannot move anything, only set the normalisers' scales.
   bool static_internal_edges = true;
-  // The mass feature as log(kg) instead of kg (MOVi masses span 1.6–59 kg).
+  // The mass feature as log(kg) instead of kg (MOVi masses span 1.4–59 kg).
   bool log_mass = false;
   // > 0: face–face edges' spans (closest point to each face vertex) are shortened to at most this
   // many metres. The floor's 20–56 m spans otherwise set the features' scale, and objects' faces

@@ -42,6 +42,10 @@ struct ModelConfig {
   // before it was recorded): the resolution the model knows, and FIGNetDynamicsWorld's default
   // node budget for finer meshes.
   int mesh_vertices = 0;
+  // The lightest and heaviest dynamic body of the training data, kg (both 0: unknown, a model
+  // file from before they were recorded). Predictors bring a scene's masses within them by one
+  // common factor (PredictionOptions::fit_masses).
+  double min_mass = 0.0, max_mass = 0.0;
   std::uint64_t seed = 0;  // parameter initialisation
 
   // "paper": L = 128, M = 10, d_c = 0.1 m (seed C.2). "small": L = 64, M = 5, about 10x fewer

@@ -45,10 +45,23 @@ struct PredictionOptions {
   // bodies sideways. 2 (a half turn) cancels a constant bias; 4 also what changes with the
   // heading as cos θ or sin θ. Costs `turns` predictions; 1: off.
   int turns = 1;
+  // Present the network the scene's dynamic masses times one common factor, the one nearest 1
+  // that brings them within the model's training masses (ModelConfig::min_mass, max_mass; a scene
+  // whose masses span more than those gets the factor that centres its span on theirs, in
+  // logarithms). Gravity and rigid contact move bodies the same whatever the common scale of
+  // their masses; the network has seen only its data's: a 1000 kg cube is 17× MOVi-A's heaviest
+  // body, and a pile of such bodies scattered tens of metres (docs/bullet-world.md). A scene
+  // within the training masses is untouched; so is every scene of a model without them.
+  bool fit_masses = true;
 
   // Throws ConfigError naming the field that is out of range.
   void validate() const;
 };
+
+// The factor PredictionOptions::fit_masses applies to the dynamic masses of `scene` for a model
+// trained on masses in [min_mass, max_mass] kg: 1 when they lie within, when the scene has no
+// dynamic body, or when the range is unknown (0).
+double mass_fit_factor(const Scene& scene, double min_mass, double max_mass);
 
 // Runs a FIGNet model: builds the graph, runs the network, un-normalises. One per thread.
 class ModelPredictor : public AccelerationPredictor {
@@ -71,6 +84,8 @@ class ModelPredictor : public AccelerationPredictor {
   // Builds the graph with `build`, runs the network and, with turns > 1, averages over turns.
   template <typename Build>
   void predict_averaged(const Scene& scene, Build&& build, Points& accelerations);
+  // The scene the network sees: `scene` itself, or its copy with fitted masses (fit_masses).
+  const Scene& with_fitted_masses(const Scene& scene);
 
   std::shared_ptr<const Model> model_;
   PredictionOptions options_;
@@ -78,7 +93,7 @@ class ModelPredictor : public AccelerationPredictor {
   Graph graph_;
   NetworkWorkspace workspace_;
   RowMatrixXf denormalized_;
-  Scene turned_;
+  Scene turned_, mass_fitted_;
   Points turned_accelerations_, turned_sum_;
 };
 
