@@ -127,6 +127,20 @@ std::vector<StressCase> stress_cases(double scale_frames) {
       stack.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 0.5 + k)));
     cases.push_back(make_case(fmt::format("stack of {} cubes", n), "stacks", stack, true));
   }
+  // The same as training saw bodies: rubber MOVi cubes (1.4 m, 3 kg, friction 0.8) on Kubric's
+  // floor, each resting on the collision margin. MOVi-A throws its bodies, so its data holds few
+  // stacks; these tell a model's own stacking from the suite's floor and masses, which differ
+  // from the data's.
+  for (int n = 2; n <= 3; ++n) {
+    SceneSpec stack = empty_scene(frames(480));
+    stack.floor->properties = Floor{}.properties;
+    const double half = 0.7, gap = stack.collision_margin;
+    for (int k = 0; k < n; ++k) {
+      stack.bodies.push_back(make_body(make_box(Vec3::Constant(half)), 1.1, 0.8, 0.7));
+      stack.bodies.back().pose.position = Vec3(0, 0, half + gap + k * (2 * half + gap));
+    }
+    cases.push_back(make_case(fmt::format("stack of {} MOVi cubes", n), "stacks", stack, true));
+  }
   // Sizes far outside training (0.7–1.4 m objects), and a 100:1 density ratio in contact.
   for (double half : {0.025, 2.5}) {
     SceneSpec drop = empty_scene(frames(240));
