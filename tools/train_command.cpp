@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -77,16 +76,11 @@ int most_mesh_vertices(const std::vector<Trajectory>& data) {
 // The lightest and heaviest dynamic body of the data (metadata like the above; under mpirun the
 // share process 0 read, whose 700+ trajectories hold MOVi's whole range).
 void record_masses(const std::vector<Trajectory>& data, ModelConfig& model) {
-  double lightest = INFINITY, heaviest = 0.0;
-  for (const Trajectory& t : data)
-    for (const TrajectoryObject& object : t.objects) {
-      if (object.kinematic || !(object.properties.mass > 0.0)) continue;
-      lightest = std::min(lightest, object.properties.mass);
-      heaviest = std::max(heaviest, object.properties.mass);
-    }
-  if (heaviest == 0.0) return;
-  model.min_mass = lightest;
-  model.max_mass = heaviest;
+  MassRange masses;
+  for (const Trajectory& t : data) masses.add(t.objects);
+  if (masses.empty()) return;
+  model.min_mass = masses.lightest;
+  model.max_mass = masses.heaviest;
 }
 
 // Time step and gravity come from the data, which must agree on them.

@@ -23,15 +23,12 @@ Eigen::Index count_nodes(const Scene& scene) {
 double mass_fit_factor(const Scene& scene, double min_mass, double max_mass) {
   if (!(min_mass > 0.0 && max_mass >= min_mass)) return 1.0;
   // The scene's dynamic masses as a span of logarithms.
-  double lightest = INFINITY, heaviest = 0.0;
-  for (const SceneObject& object : scene.objects) {
-    if (object.kinematic || !(object.properties.mass > 0.0)) continue;
-    lightest = std::min(lightest, object.properties.mass);
-    heaviest = std::max(heaviest, object.properties.mass);
-  }
-  if (!(heaviest > 0.0) || !std::isfinite(heaviest)) return 1.0;
-  const double low = std::log(min_mass) - std::log(lightest);   // least shift that lifts it in
-  const double high = std::log(max_mass) - std::log(heaviest);  // most shift that keeps it in
+  MassRange masses;
+  masses.add(scene.objects);
+  if (masses.empty() || !std::isfinite(masses.heaviest)) return 1.0;
+  // The least shift that lifts the lightest in, and the most that keeps the heaviest in.
+  const double low = std::log(min_mass) - std::log(masses.lightest);
+  const double high = std::log(max_mass) - std::log(masses.heaviest);
   // The shift nearest 0 that fits the span inside; centred on the range when it does not fit.
   const double shift = low <= high ? std::clamp(0.0, low, high) : 0.5 * (low + high);
   return shift == 0.0 ? 1.0 : std::exp(shift);

@@ -3,6 +3,8 @@
 // interface, so they run the same code path whatever predicts.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <span>
 
@@ -56,6 +58,22 @@ struct PredictionOptions {
 
   // Throws ConfigError naming the field that is out of range.
   void validate() const;
+};
+
+// The lightest and heaviest dynamic body seen, kg (kinematic and massless bodies left out: their
+// mass moves nothing). What `fignet train` records and what fit_masses compares it with.
+struct MassRange {
+  double lightest = INFINITY, heaviest = 0.0;
+  bool empty() const { return !(heaviest > 0.0); }
+  // Widens the range by `objects` (SceneObjects or TrajectoryObjects).
+  template <class Objects>
+  void add(const Objects& objects) {
+    for (const auto& object : objects) {
+      if (object.kinematic || !(object.properties.mass > 0.0)) continue;
+      lightest = std::min(lightest, object.properties.mass);
+      heaviest = std::max(heaviest, object.properties.mass);
+    }
+  }
 };
 
 // The factor PredictionOptions::fit_masses applies to the dynamic masses of `scene` for a model
