@@ -58,8 +58,9 @@ void run_generate(GenerateArgs args) {
   }
   const std::vector<Trajectory> trajectories = future.get();
   bar.finish(total);
-  write_trajectories(args.out, trajectories,
-                     {args.options.scene.preset, FIGNET_VERSION, args.options.seed});
+  write_trajectories(
+      args.out, trajectories,
+      {args.options.scene.preset, FIGNET_VERSION, args.options.seed, args.options.scene.stacks});
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   fmt::print("wrote {} trajectories ({} frames each) to {} in {:.1f} s\n", trajectories.size(),
@@ -85,11 +86,19 @@ void add_generate_command(CLI::App& app) {
                   "Frames per trajectory (0: the preset's, movi-a 96 at 48 Hz, pushing 42)")
       ->check(CLI::Range(0, 100'000))
       ->capture_default_str();
-  cmd->add_option("--min-objects", args->options.scene.min_objects, "Fewest objects per scene")
-      ->check(CLI::Range(1, 1000))
+  cmd->add_option("--min-objects", args->options.scene.min_objects,
+                  "Fewest tossed objects per scene (at least 1 without --stacks)")
+      ->check(CLI::Range(0, 1000))
       ->capture_default_str();
-  cmd->add_option("--max-objects", args->options.scene.max_objects, "Most objects per scene")
-      ->check(CLI::Range(1, 1000))
+  cmd->add_option("--max-objects", args->options.scene.max_objects, "Most tossed objects per scene")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  cmd->add_option(
+         "--stacks", args->options.scene.stacks,
+         "Stacks of 1-3 cubes and upright cylinders standing still on the floor of each "
+         "movi-a or movi-b scene, placed before the tossed objects (--min-objects may then "
+         "be 0); 0: the preset's own scenes")
+      ->check(CLI::Range(0, 20))
       ->capture_default_str();
   cmd->add_option("--assets", args->options.scene.assets,
                   "Folder of mesh files (OBJ, STL, PLY, glTF, OFF): extra objects for movi-b, the "

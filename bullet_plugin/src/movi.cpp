@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <numbers>
 #include <random>
 
 #include "fignet/bullet/mesh_file.h"
@@ -91,6 +92,72 @@ const std::vector<std::filesystem::path>& asset_files(const std::filesystem::pat
   return it->second;
 }
 
+using BoundingSpheres = std::vector<std::pair<Vec3, double>>;
+
+bool clear_of(const BoundingSpheres& placed, const Vec3& center, double radius) {
+  for (const auto& [other, other_radius] : placed) {
+    if ((other - center).norm() <= other_radius + radius) return false;
+  }
+  return true;
+}
+
+// options.stacks stacks of 1–3 cubes and upright cylinders at rest on spec's floor. Their own
+// generator keeps the tossed objects' draws as MOVi's; `placed` receives their bounding spheres
+// so the tossed objects spawn clear of them.
+void add_stacks(const MoviOptions& options, bool movi_a, std::uint64_t seed, SceneSpec& spec,
+                BoundingSpheres& placed) {
+  std::mt19937_64 rng(seed ^ 0x5374'6163'6b73'0001ULL);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Source shapes[] = {{"cube"}, {"cylinder"}};  // both flat on top and bottom when upright
+  const double margin = spec.collision_margin;
+  for (int s = 0; s < options.stacks; ++s) {
+    // Build the stack around the vertical axis through the origin, then move it to a free spot.
+    const int levels = 1 + std::min(2, static_cast<int>(unit(rng) * 3));
+    std::vector<BodySpec> stack;
+    std::vector<double> half_widths;  // cube and cylinder alike: half-width = half-height = scale
+    double top = spec.floor->height;
+    Vec3 below_center = Vec3::Zero();
+    for (int level = 0; level < levels; ++level) {
+      const Source& shape = shapes[unit(rng) < 0.5 ? 0 : 1];
+      const double scale = movi_a ? (unit(rng) < 0.5 ? 0.7 : 1.4) : 0.7 + 0.7 * unit(rng);
+      const Material& material = unit(rng) < 0.5 ? kMetal : kRubber;
+      BodySpec body = make_object(shape, options.mesh_import, material, scale);
+      const double yaw = 2.0 * std::numbers::pi * unit(rng);
+      body.pose.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
+      // Shifted off its support's axis by at most a tenth of the narrower half-width: the centre
+      // of mass stays well inside the support, so the stack stands in Bullet.
+      Vec3 shift = Vec3::Zero();
+      if (level > 0) {
+        const double reach = 0.1 * std::min(scale, half_widths.back()) * std::sqrt(unit(rng));
+        const double angle = 2.0 * std::numbers::pi * unit(rng);
+        shift = Vec3(reach * std::cos(angle), reach * std::sin(angle), 0.0);
+      }
+      body.pose.position = below_center + shift;
+      body.pose.position.z() = top + margin + scale;
+      top = body.pose.position.z() + scale;
+      below_center = body.pose.position;
+      half_widths.push_back(scale);
+      stack.push_back(std::move(body));
+    }
+    // A spot where no body's bounding sphere meets an earlier stack's.
+    for (int attempt = 0; attempt < 100; ++attempt) {
+      const Vec3 spot(-4 + 8 * unit(rng), -4 + 8 * unit(rng), 0.0);
+      bool clear = true;
+      for (const BodySpec& body : stack) {
+        const double radius = body.mesh->vertices().rowwise().norm().maxCoeff();
+        clear = clear && clear_of(placed, body.pose.position + spot, radius);
+      }
+      if (!clear) continue;
+      for (BodySpec& body : stack) {
+        body.pose.position += spot;
+        placed.emplace_back(body.pose.position, body.mesh->vertices().rowwise().norm().maxCoeff());
+        spec.bodies.push_back(std::move(body));
+      }
+      break;
+    }
+  }
+}
+
 }  // namespace
 
 const std::vector<std::string>& movi_presets() {
@@ -106,7 +173,10 @@ int frames_or_default(const MoviOptions& options, int preset_frames) {
 }
 
 SceneSpec sample_scene(const MoviOptions& options, std::uint64_t seed) {
-  if (options.preset == "pushing") return sample_pushing_scene(options, seed);
+  if (options.preset == "pushing") {
+    if (options.stacks != 0) throw ConfigError("stacks need preset movi-a or movi-b, not pushing");
+    return sample_pushing_scene(options, seed);
+  }
   return sample_movi_scene(options, seed);
 }
 
@@ -116,9 +186,17 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
     throw ConfigError(fmt::format("unknown scene preset '{}'; available: {}", options.preset,
                                   fmt::join(movi_presets(), ", ")));
   }
-  if (options.min_objects < 1 || options.max_objects < options.min_objects) {
-    throw ConfigError(fmt::format("objects range {}..{} is empty or below 1", options.min_objects,
-                                  options.max_objects));
+  // Tossed objects: at least one, unless stacks stand in the scene.
+  const int fewest = options.stacks > 0 ? 0 : 1;
+  if (options.min_objects < fewest || options.max_objects < options.min_objects) {
+    throw ConfigError(fmt::format("objects range {}..{} is empty or below {}", options.min_objects,
+                                  options.max_objects, fewest));
+  }
+  if (options.stacks < 0) {
+    throw ConfigError(fmt::format("stacks = {} (must be >= 0)", options.stacks));
+  }
+  if (options.stacks > 0 && movi_c) {
+    throw ConfigError("stacks need cubes and cylinders: preset movi-a or movi-b, not movi-c");
   }
   if (movi_c && options.assets.empty()) {
     throw ConfigError("preset movi-c takes its objects from a folder of mesh files: give one");
@@ -151,7 +229,8 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
   const int source_count = static_cast<int>(sources.size());
   const int count = options.min_objects +
                     static_cast<int>(unit(rng) * (options.max_objects - options.min_objects + 1));
-  std::vector<std::pair<Vec3, double>> spheres;  // placed bodies' bounding spheres
+  BoundingSpheres spheres;  // placed bodies' bounding spheres
+  if (options.stacks > 0) add_stacks(options, movi_a, seed, spec, spheres);
   for (int i = 0; i < std::min(count, options.max_objects); ++i) {
     const Source& source = sources[static_cast<int>(unit(rng) * source_count) % source_count];
     // Scale: MOVi-A 0.7 or 1.4, MOVi-B U(0.7, 1.4), MOVi-C U(0.75, 3.0).
@@ -171,9 +250,7 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
               .col(2)
               .minCoeff();
       placed = body.pose.position.z() + lowest > spec.floor->height;
-      for (const auto& [center, r] : spheres) {
-        placed = placed && (center - body.pose.position).norm() > r + radius;
-      }
+      placed = placed && clear_of(spheres, body.pose.position, radius);
     }
     if (!placed) continue;  // no free spot in 100 tries: the scene gets one object fewer
     const Vec3 target(-4 + 8 * unit(rng), -4 + 8 * unit(rng), 0.0);

@@ -35,6 +35,22 @@ void expect_identical(const std::vector<Trajectory>& a, const std::vector<Trajec
   }
 }
 
+// How many face pairs of different bodies lie within `radius` of each other.
+size_t face_pairs_within(const std::vector<std::pair<const TriangleMesh*, Pose>>& bodies,
+                         double radius) {
+  std::vector<Points> posed;
+  for (const auto& [mesh, pose] : bodies) posed.push_back(posed_vertices(*mesh, pose));
+  std::vector<PosedMesh> meshes;
+  for (size_t i = 0; i < bodies.size(); ++i)
+    meshes.push_back({bodies[i].first, posed[i].data(), false});
+  ContactFinder finder;
+  finder.update(meshes, false);
+  std::vector<ObjectPair> pairs;
+  std::vector<FacePair> close;
+  finder.find_all_face_pairs(radius, pairs, close);
+  return close.size();
+}
+
 TEST(Generator, SameSeedSameTrajectoriesWhateverTheThreadsAndShards) {
   const auto one = generate_dataset(small_options(1));
   expect_identical(one, generate_dataset(small_options(2)));
@@ -85,19 +101,9 @@ TEST(Generator, ScenesStartWithoutOverlapAndStayAboveTheFloor) {
   options.scene.frames = 96;
   for (const Trajectory& t : generate_dataset(options)) {
     // Frame 0: no two objects' surfaces touch (the bounding-sphere spawn test is conservative).
-    std::vector<Points> posed;
-    std::vector<PosedMesh> meshes;
-    for (const auto& object : t.objects)
-      posed.push_back(posed_vertices(*object.mesh, object.poses[0]));
-    for (size_t o = 0; o < t.objects.size(); ++o) {
-      meshes.push_back({t.objects[o].mesh.get(), posed[o].data(), false});
-    }
-    ContactFinder finder;
-    finder.update(meshes, false);
-    std::vector<ObjectPair> pairs;
-    std::vector<FacePair> touching;
-    finder.find_all_face_pairs(0.0, pairs, touching);
-    EXPECT_TRUE(touching.empty()) << "seed " << t.seed;
+    std::vector<std::pair<const TriangleMesh*, Pose>> bodies;
+    for (const auto& object : t.objects) bodies.emplace_back(object.mesh.get(), object.poses[0]);
+    EXPECT_EQ(face_pairs_within(bodies, 0.0), 0u) << "seed " << t.seed;
     // Every frame: every vertex above the floor, up to Bullet's transient contact penetration,
     // which is at most one step of travel at impact: a 5 m drop lands at 10 m/s, 10/240 = 4.2 cm.
     for (const auto& object : t.objects) {
@@ -180,6 +186,94 @@ TEST(Generator, MoviBUsesEveryShapeAtContinuousScales) {
   EXPECT_EQ(names.size(), movi_shape_names().size());
 }
 
+MoviOptions stacks_only(int stacks) {
+  MoviOptions options;
+  options.stacks = stacks;
+  options.min_objects = options.max_objects = 0;
+  return options;
+}
+
+double half_width(const BodySpec& body) {
+  return body.mesh->vertices().col(0).maxCoeff();
+}
+double lowest(const BodySpec& body) {
+  return posed_vertices(*body.mesh, body.pose).col(2).minCoeff();
+}
+double highest(const BodySpec& body) {
+  return posed_vertices(*body.mesh, body.pose).col(2).maxCoeff();
+}
+
+// Every stacked body is an upright cube or cylinder at rest, lying at the collision margin on the
+// floor or on one body below it, nearly centred on it; the levels are 1–3 high.
+TEST(Generator, StacksStandStillOnTheFloorOrSquarelyOnOneBody) {
+  std::set<int> heights;
+  for (std::uint64_t seed = 0; seed < 20; ++seed) {
+    const SceneSpec spec = sample_movi_scene(stacks_only(3), trajectory_seed(3, seed));
+    const double margin = spec.collision_margin;
+    std::vector<int> level(spec.bodies.size(), 0);
+    for (size_t i = 0; i < spec.bodies.size(); ++i) {
+      const BodySpec& body = spec.bodies[i];
+      const std::string& name = body.mesh->name();
+      EXPECT_TRUE(name == "cube" || name == "cylinder") << name;
+      EXPECT_EQ(body.linear_velocity, Vec3::Zero());
+      EXPECT_EQ(body.angular_velocity, Vec3::Zero());
+      EXPECT_LT((body.pose.orientation * Vec3::UnitZ() - Vec3::UnitZ()).norm(), 1e-12);
+      if (std::abs(lowest(body) - spec.floor->height - margin) < 1e-9) {
+        level[i] = 1;
+      } else {
+        int supports = 0;
+        for (size_t j = 0; j < i; ++j) {
+          const BodySpec& below = spec.bodies[j];
+          if (std::abs(lowest(body) - highest(below) - margin) > 1e-9) continue;
+          const double off_axis = (body.pose.position - below.pose.position).head<2>().norm();
+          if (off_axis > 0.1 * std::min(half_width(body), half_width(below)) + 1e-9) continue;
+          ++supports;
+          level[i] = level[j] + 1;
+        }
+        EXPECT_EQ(supports, 1) << "seed " << seed << " body " << i;
+      }
+      heights.insert(level[i]);
+    }
+  }
+  EXPECT_EQ(heights, (std::set<int>{1, 2, 3}));
+}
+
+// The data must show stacks standing: in Bullet they hold over a whole trajectory.
+TEST(Generator, StacksStandInBullet) {
+  GenerateOptions options;
+  options.scene = stacks_only(3);
+  options.count = 4;
+  options.seed = 8;
+  options.threads = 2;
+  int bodies = 0;
+  for (const Trajectory& t : generate_dataset(options)) {
+    for (const TrajectoryObject& object : t.objects) {
+      ++bodies;
+      const Pose& first = object.poses.front();
+      const Pose& last = object.poses.back();
+      EXPECT_LT((last.position - first.position).norm(), 0.02) << "seed " << t.seed;
+      EXPECT_LT(last.orientation.angularDistance(first.orientation), 0.02) << "seed " << t.seed;
+    }
+  }
+  EXPECT_GE(bodies, 12);
+}
+
+// Tossed objects spawn clear of the stacks.
+TEST(Generator, TossedObjectsSpawnClearOfTheStacks) {
+  for (std::uint64_t seed = 0; seed < 20; ++seed) {
+    MoviOptions options;
+    options.stacks = 2;
+    const SceneSpec spec = sample_movi_scene(options, trajectory_seed(4, seed));
+    std::vector<std::pair<const TriangleMesh*, Pose>> bodies;
+    for (const BodySpec& body : spec.bodies) bodies.emplace_back(body.mesh.get(), body.pose);
+    // Stacked bodies lie at the margin on one another; nothing else comes that close.
+    EXPECT_EQ(face_pairs_within(bodies, spec.collision_margin / 2), 0u) << "seed " << seed;
+    int tossed = 0;
+    for (const BodySpec& body : spec.bodies) tossed += body.linear_velocity != Vec3::Zero();
+    EXPECT_GE(tossed, 1) << "seed " << seed;
+  }
+}
+
 TEST(Generator, BadOptionsAreConfigErrors) {
   GenerateOptions options = small_options(1);
   options.shard = 2;
@@ -192,6 +286,17 @@ TEST(Generator, BadOptionsAreConfigErrors) {
   options.scene.min_objects = 5;
   options.scene.max_objects = 4;
   EXPECT_THROW(generate_dataset(options), ConfigError);
+  options = small_options(1);
+  options.scene.min_objects = 0;  // a scene without any body
+  EXPECT_THROW(generate_dataset(options), ConfigError);
+  options.scene.stacks = -1;
+  EXPECT_THROW(generate_dataset(options), ConfigError);
+  for (const char* preset : {"movi-c", "pushing"}) {
+    options = small_options(1);
+    options.scene.preset = preset;
+    options.scene.stacks = 1;
+    EXPECT_THROW(generate_dataset(options), ConfigError) << preset;
+  }
 }
 
 }  // namespace

@@ -187,6 +187,7 @@ void write_trajectories(const std::filesystem::path& path, std::span<const Traje
     hdf5::write_attribute(root, "preset", info.preset);
     hdf5::write_attribute(root, "generator_version", info.generator_version);
     hdf5::write_attribute(root, "seed", static_cast<long long>(info.seed));
+    hdf5::write_attribute(root, "stacks", static_cast<long long>(info.stacks));
     hdf5::write_attribute(root, "num_trajectories", static_cast<long long>(trajectories.size()));
     H5::Group group = file.createGroup("trajectories");
     for (size_t i = 0; i < trajectories.size(); ++i) {
@@ -218,6 +219,9 @@ long long read_file(const std::filesystem::path& path, DatasetInfo* info, long l
       info->preset = hdf5::read_string(root, "preset");
       info->generator_version = hdf5::read_string(root, "generator_version");
       info->seed = static_cast<std::uint64_t>(hdf5::read_integer(root, "seed"));
+      // Files written before stacks existed hold the preset's scenes.
+      info->stacks =
+          root.attrExists("stacks") ? static_cast<int>(hdf5::read_integer(root, "stacks")) : 0;
     }
     const long long count = hdf5::read_integer(root, "num_trajectories");
     const H5::Group group = file.openGroup("trajectories");

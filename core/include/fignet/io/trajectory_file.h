@@ -20,6 +20,7 @@ struct DatasetInfo {
   std::string preset;             // e.g. "movi-a"
   std::string generator_version;  // the generating program's version
   std::uint64_t seed = 0;         // the generator's base seed
+  int stacks = 0;                 // stacks at rest per scene (generate --stacks); 0: the preset's
 };
 
 // Writes to a temporary file beside `path`, then renames it into place. Throws FileError.
