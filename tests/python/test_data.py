@@ -25,16 +25,19 @@ def test_generated_trajectories_survive_a_file_round_trip(tmp_path):
             np.testing.assert_array_equal(a.faces(o), b.faces(o))
 
 
-def test_generate_gives_what_the_command_line_gives(tmp_path, cli):
+@pytest.mark.parametrize("stacks", [0, 2])
+def test_generate_gives_what_the_command_line_gives(tmp_path, cli, stacks):
     path = tmp_path / "cli.h5"
     subprocess.run(
         [cli, "generate", "--preset", "movi-a", "--count", "2", "--seed", "7", "--frames", "10",
-         "--out", path],
+         "--stacks", str(stacks), "--out", path],
         check=True, capture_output=True,
     )
     from_cli = fignet.read_trajectories(path)
-    from_python = fignet.generate("movi-a", count=2, seed=7, frames=10, threads=1)
+    from_python = fignet.generate("movi-a", count=2, seed=7, frames=10, threads=1, stacks=stacks)
+    assert len(from_cli) == len(from_python) == 2
     for a, b in zip(from_cli, from_python):
+        assert a.num_objects == b.num_objects
         np.testing.assert_array_equal(a.positions, b.positions)
         np.testing.assert_array_equal(a.quaternions, b.quaternions)
 
