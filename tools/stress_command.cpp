@@ -2,6 +2,7 @@
 // Bullet and by FIGNet worlds, as a table on the terminal and, with --markdown, a document that
 // names the command that made it.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include "fignet/bullet/stress.h"
 #include "fignet/io/model_file.h"
 #include "fignet/rollout/metrics.h"
+#include "fignet/rollout/predictor.h"
 #include "progress.h"
 #include "text_file.h"
 
@@ -45,8 +47,49 @@ double shift_difference(const Trajectory& far, const Trajectory& near, const Vec
   return largest;
 }
 
+// "0.3" for a range of one value, else "0.4-0.8".
+std::string range_text(const DataRange& range) {
+  return range.lowest == range.highest ? fmt::format("{:.3g}", range.lowest)
+                                       : fmt::format("{:.3g}-{:.3g}", range.lowest, range.highest);
+}
+
+using NamedModels = std::vector<std::pair<std::string, std::shared_ptr<const Model>>>;
+
+// Per model that records its data's materials, the cases whose dynamic bodies or floor lie
+// outside them: there the model guesses. Empty when every case is within.
+std::string unfamiliar_materials(const std::vector<bullet::StressCase>& cases,
+                                 const NamedModels& models) {
+  std::string text;
+  for (const auto& [name, model] : models) {
+    const ModelConfig& c = model->config();
+    if (!c.friction.known() || !c.floor_friction.known()) continue;
+    std::vector<std::string> listed;
+    for (const bullet::StressCase& stress_case : cases) {
+      int bodies = 0, outside = 0;
+      for (const bullet::BodySpec& body : stress_case.scene.bodies) {
+        if (body.kinematic) continue;
+        ++bodies;
+        outside += !familiar_material(body.properties, c);
+      }
+      const bool floor = stress_case.scene.floor && !familiar_floor(*stress_case.scene.floor, c);
+      if (outside == 0 && !floor) continue;
+      std::vector<std::string> what;
+      if (floor) what.push_back("floor");
+      if (outside > 0) what.push_back(fmt::format("{} of {} bodies", outside, bodies));
+      listed.push_back(fmt::format("{} ({})", stress_case.name, fmt::join(what, ", ")));
+    }
+    if (listed.empty()) continue;
+    text += fmt::format(
+        "\nMaterials outside {}'s training data (bodies: friction {}, restitution {}; floor: "
+        "friction {}, restitution {}), where it guesses: {}.\n",
+        name, range_text(c.friction), range_text(c.restitution), range_text(c.floor_friction),
+        range_text(c.floor_restitution), fmt::join(listed, "; "));
+  }
+  return text;
+}
+
 void run_stress(const StressArgs& args) {
-  std::vector<std::pair<std::string, std::shared_ptr<const Model>>> models;
+  NamedModels models;
   for (const fs::path& file : args.models) {
     models.emplace_back(file.filename().string(), std::make_shared<const Model>(load_model(file)));
   }
@@ -91,6 +134,8 @@ void run_stress(const StressArgs& args) {
       "rest; late speed: the fastest body over the run's second half (growth shows energy "
       "gained); error: mean translation error against Bullet at 240 Hz (chaotic scenes: for "
       "information only).\n");
+  const std::string materials = unfamiliar_materials(cases, models);
+  fmt::print("{}", materials);
   if (!args.markdown.empty()) {
     const std::string doc = fmt::format(
         "# Stress suite: FIGNet next to native Bullet at the extremes\n\n"
@@ -105,8 +150,8 @@ void run_stress(const StressArgs& args) {
         "`bullet_plugin/include/fignet/bullet/stress.h`. The lowest point is that of any vertex "
         "relative to the floor over the whole run: tunnelling or sinking shows as a large "
         "negative value. Drift is measured for scenes started at rest; the late speed is the "
-        "fastest body over the second half of the run.\n\n{}\n",
-        args.command_line, table);
+        "fastest body over the second half of the run.\n\n{}{}",
+        args.command_line, table, materials);
     write_text_atomically(args.markdown, doc);
     fmt::print("wrote {}\n", args.markdown.string());
   }

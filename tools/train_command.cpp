@@ -83,12 +83,28 @@ void record_masses(const std::vector<Trajectory>& data, ModelConfig& model) {
   model.max_mass = masses.heaviest;
 }
 
+// The friction and restitution of the data's bodies and floors (metadata like the above).
+void record_materials(const std::vector<Trajectory>& data, ModelConfig& model) {
+  model.friction = model.restitution = model.floor_friction = model.floor_restitution = {};
+  for (const Trajectory& t : data) {
+    for (const TrajectoryObject& object : t.objects) {
+      model.friction.add(object.properties.friction);
+      model.restitution.add(object.properties.restitution);
+    }
+    if (t.floor) {
+      model.floor_friction.add(t.floor->properties.friction);
+      model.floor_restitution.add(t.floor->properties.restitution);
+    }
+  }
+}
+
 // Time step and gravity come from the data, which must agree on them.
 void adopt_physics(const std::vector<Trajectory>& data, ModelConfig& model) {
   model.time_step = data.front().time_step;
   model.gravity = data.front().gravity;
   model.mesh_vertices = most_mesh_vertices(data);
   record_masses(data, model);
+  record_materials(data, model);
   for (size_t i = 0; i < data.size(); ++i) {
     if (data[i].time_step != model.time_step || data[i].gravity != model.gravity) {
       throw ConfigError(fmt::format(
@@ -166,6 +182,7 @@ void run_train(const TrainArgs& args) {
     config.model = checkpoint.model->config();
     if (config.model.mesh_vertices == 0) config.model.mesh_vertices = most_mesh_vertices(data);
     if (config.model.max_mass == 0.0) record_masses(data, config.model);
+    if (!config.model.friction.known()) record_materials(data, config.model);
     config.trainer = checkpoint.trainer_config;
     resumed_batch_size = config.trainer.batch_size;
     // The run's own length unless --steps says otherwise.

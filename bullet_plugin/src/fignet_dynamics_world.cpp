@@ -156,6 +156,8 @@ struct FIGNetDynamicsWorld::Impl {
   ShapeMeshCache shapes;
   std::unordered_map<const btCollisionObject*, BodyState> states;
   FIGNetStepStats stats;
+  // The model's config, for its data's materials (unknown ranges with a stand-in predictor).
+  ModelConfig model_config;
   std::vector<std::pair<Vec3, Vec3>> face_lines;  // last step's face–face edges, for drawing
 
   std::optional<GraphBuilder> contact_query;  // which bodies have collision edges
@@ -958,7 +960,9 @@ FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
                                                        .turns = options.turns,
                                                        .fit_masses = options.fit_masses}),
                           model->config().graph, model->config().time_step, model->config().gravity,
-                          with_model_budget(options, model->config())) {}
+                          with_model_budget(options, model->config())) {
+  impl_->model_config = model->config();
+}
 
 FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
                                          btBroadphaseInterface* broadphase,
@@ -1153,6 +1157,12 @@ void FIGNetDynamicsWorld::internalSingleStepSimulation(btScalar time_step) {
   impl.stats.kinematic_objects = static_cast<int>(impl.scene.objects.size()) - networked;
   impl.stats.candidate_pairs = static_cast<int>(impl.candidates.size());
   impl.stats.face_edges = networked > 0 ? impl.predictor->last_face_edges() : 0;
+  for (int k = 0; k < networked; ++k) {
+    impl.stats.unfamiliar_bodies +=
+        !familiar_material(impl.scene.objects[k].properties, impl.model_config);
+  }
+  impl.stats.unfamiliar_floor =
+      networked > 0 && impl.scene.floor && !familiar_floor(*impl.scene.floor, impl.model_config);
   impl.stats.mesh_nodes = 0;
   if (networked > 0) {
     for (const SceneObject& object : impl.scene.objects) {

@@ -506,6 +506,49 @@ struct ModelScene {
   WorldFixture fixture;
 };
 
+// The world counts the simulated bodies, and the floor, whose materials lie outside the model's
+// training data's; a model that does not record them counts nothing.
+TEST(FIGNetWorld, CountsBodiesOfMaterialsTheModelsDataDidNotHold) {
+  // Counts of the first step, and whether the floor is unfamiliar once its restitution is 0.9.
+  const auto run = [](const ModelConfig& config) {
+    WorldFixture fixture(std::make_shared<const Model>(config),
+                         FIGNetWorldOptions::network_alone());
+    btRigidBody* floor =
+        fixture.add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0, Pose{});
+    floor->setFriction(0.3f);
+    floor->setRestitution(0.5f);
+    // Metal and rubber as MOVi-A has them, then a body of friction 1.2: 5 cm above the floor,
+    // within the collision radius, 1 m apart.
+    const double materials[][2] = {{0.4, 0.3}, {0.8, 0.7}, {1.2, 0.3}};
+    for (int i = 0; i < 3; ++i) {
+      btRigidBody* box = fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0,
+                                     at(Vec3(1.0 * i, 0, 0.25)));
+      box->setFriction(static_cast<btScalar>(materials[i][0]));
+      box->setRestitution(static_cast<btScalar>(materials[i][1]));
+    }
+    fixture.step();
+    const FIGNetStepStats first = fixture.world.last_step_stats();
+    floor->setRestitution(0.9f);
+    fixture.step();
+    return std::pair(first, fixture.world.last_step_stats().unfamiliar_floor);
+  };
+  ModelConfig config = ModelScene::make_model()->config();
+  config.friction = {0.4, 0.8};
+  config.restitution = {0.3, 0.7};
+  config.floor_friction = {0.3, 0.3};
+  config.floor_restitution = {0.5, 0.5};
+  const auto [recorded, floor_changed] = run(config);
+  EXPECT_EQ(recorded.simulated_bodies, 3);
+  EXPECT_EQ(recorded.unfamiliar_bodies, 1);
+  EXPECT_FALSE(recorded.unfamiliar_floor);
+  EXPECT_TRUE(floor_changed);
+  config.friction = config.restitution = config.floor_friction = config.floor_restitution = {};
+  const auto [unknown, unknown_floor_changed] = run(config);
+  EXPECT_EQ(unknown.simulated_bodies, 3);
+  EXPECT_EQ(unknown.unfamiliar_bodies, 0);
+  EXPECT_FALSE(unknown_floor_changed);
+}
+
 // The free-flight path changes nothing for bodies in contact: their graph and the network's
 // answer for them do not depend on bodies they have no edge to. With every body in contact the
 // two runs are the same bits, and a body far up, left out of the network, leaves the others'

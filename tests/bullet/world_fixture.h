@@ -40,6 +40,10 @@ struct WorldFixture {
                         const bullet::FIGNetWorldOptions& options = {})
       : world(&dispatcher, &broadphase, &solver, &configuration, std::move(predictor), graph, kStep,
               Vec3(0, 0, -10), options) {}
+  // The world of a loaded model, as users construct it.
+  explicit WorldFixture(std::shared_ptr<const Model> model,
+                        const bullet::FIGNetWorldOptions& options = {})
+      : world(&dispatcher, &broadphase, &solver, &configuration, std::move(model), options) {}
   ~WorldFixture() {
     for (auto& body : bodies) world.removeRigidBody(body.get());
   }

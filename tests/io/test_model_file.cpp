@@ -29,6 +29,9 @@ class ModelFile : public testing::TempFolderTest {
     config.graph.contact_motion = true;
     config.min_mass = 1.6;
     config.max_mass = 59.0;
+    config.friction = {0.4, 0.8};
+    config.restitution = {0.3, 0.7};
+    config.floor_friction = {0.3, 0.3};  // floor_restitution left unknown
     Model fresh(config);
     Normalizers normalizers = fresh.normalizers();
     RowMatrixXf rows = RowMatrixXf::Random(10, normalizers.mesh_node.size());
@@ -71,6 +74,12 @@ TEST_F(ModelFile, SaveThenLoadIsBitExact) {
   EXPECT_TRUE(loaded.config().graph.contact_motion);
   EXPECT_EQ(loaded.config().min_mass, 1.6);
   EXPECT_EQ(loaded.config().max_mass, 59.0);
+  EXPECT_EQ(loaded.config().friction.lowest, 0.4);
+  EXPECT_EQ(loaded.config().friction.highest, 0.8);
+  EXPECT_EQ(loaded.config().restitution.lowest, 0.3);
+  EXPECT_EQ(loaded.config().restitution.highest, 0.7);
+  EXPECT_EQ(loaded.config().floor_friction.highest, 0.3);
+  EXPECT_FALSE(loaded.config().floor_restitution.known());
   EXPECT_EQ(loaded.normalizers().face_edge.size(), 34 + 1 + 5);  // the logarithm, the motion
   EXPECT_EQ(loaded.normalizers().mesh_node.sum(), model_->normalizers().mesh_node.sum());
   EXPECT_EQ(loaded.normalizers().mesh_node.sum_squares(),

@@ -96,6 +96,30 @@ TEST(TrainingConfig, BadInputNamesTheField) {
             std::string::npos);
   config.model.max_mass = 3.0;
   EXPECT_NO_THROW(config.validate());
+  config.model.friction = {-0.1, 0.5};
+  EXPECT_NE(error_of([&] { config.validate(); }).find("friction range [-0.1, 0.5]"),
+            std::string::npos);
+  config.model.friction = {};
+  EXPECT_NO_THROW(config.validate());
+}
+
+TEST(DataRange, WidensToHoldEachValueAndHoldsEverythingWhileUnknown) {
+  DataRange range;
+  EXPECT_FALSE(range.known());
+  EXPECT_TRUE(range.holds(-5.0));
+  range.add(0.8);
+  EXPECT_TRUE(range.known());
+  EXPECT_TRUE(range.holds(0.8));
+  EXPECT_FALSE(range.holds(0.4));
+  range.add(0.4);
+  EXPECT_EQ(range.lowest, 0.4);
+  EXPECT_EQ(range.highest, 0.8);
+  EXPECT_TRUE(range.holds(0.6));
+  // A value that went through a float32 file or Bullet's btScalar is still the data's.
+  EXPECT_TRUE(range.holds(static_cast<float>(0.4)));
+  EXPECT_TRUE(range.holds(static_cast<float>(0.8)));
+  EXPECT_FALSE(range.holds(0.39));
+  EXPECT_FALSE(range.holds(0.81));
 }
 
 // fignet train lets decay_steps follow --steps unless a --set or --config named it.

@@ -3,6 +3,10 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <array>
+#include <type_traits>
+#include <utility>
+
 #include "fignet/error.h"
 #include "hdf5_util.h"
 #include "model_contents.h"
@@ -30,6 +34,17 @@ auto named(N& n, const Network& network) {
   return result;
 }
 
+// The training data's material ranges by attribute name (min_NAME, max_NAME; optional).
+template <typename Config>
+auto material_ranges(Config& c) {
+  using Range = std::conditional_t<std::is_const_v<Config>, const DataRange, DataRange>;
+  return std::array<std::pair<const char*, Range*>, 4>{
+      {{"friction", &c.friction},
+       {"restitution", &c.restitution},
+       {"floor_friction", &c.floor_friction},
+       {"floor_restitution", &c.floor_restitution}}};
+}
+
 void write_config(H5::Group group, const ModelConfig& c) {
   using hdf5::write_attribute;
   write_attribute(group, "preset", c.preset);
@@ -45,6 +60,11 @@ void write_config(H5::Group group, const ModelConfig& c) {
   write_attribute(group, "mesh_vertices", static_cast<long long>(c.mesh_vertices));
   write_attribute(group, "min_mass", c.min_mass);
   write_attribute(group, "max_mass", c.max_mass);
+  for (const auto& [name, range] : material_ranges(c)) {
+    if (!range->known()) continue;  // absent: unknown
+    write_attribute(group, fmt::format("min_{}", name), range->lowest);
+    write_attribute(group, fmt::format("max_{}", name), range->highest);
+  }
   write_attribute(group, "collision_radius", c.graph.collision_radius);
   write_attribute(group, "history", static_cast<long long>(c.graph.history));
   write_attribute(group, "object_nodes", static_cast<long long>(c.graph.object_nodes));
@@ -85,6 +105,13 @@ ModelConfig read_config(const H5::Group& group) {
   if (group.attrExists("min_mass") && group.attrExists("max_mass")) {
     c.min_mass = read_double(group, "min_mass");
     c.max_mass = read_double(group, "max_mass");
+  }
+  for (const auto& [name, range] : material_ranges(c)) {
+    const std::string low = fmt::format("min_{}", name), high = fmt::format("max_{}", name);
+    if (group.attrExists(low) && group.attrExists(high)) {
+      range->lowest = read_double(group, low);
+      range->highest = read_double(group, high);
+    }
   }
   c.graph.collision_radius = read_double(group, "collision_radius");
   c.graph.history = static_cast<int>(read_integer(group, "history"));

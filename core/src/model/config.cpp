@@ -3,11 +3,25 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "fignet/error.h"
 
 namespace fignet {
+
+void DataRange::add(double value) {
+  lowest = known() ? std::min(lowest, value) : value;
+  highest = known() ? std::max(highest, value) : value;
+}
+
+bool DataRange::holds(double value) const {
+  // Trajectory files store properties as float32: a value that went through one is not
+  // outside the range it came from.
+  const double slack = 1e-6 * std::max(1.0, std::max(std::abs(lowest), std::abs(highest)));
+  return !known() || (value >= lowest - slack && value <= highest + slack);
+}
 
 const std::vector<std::string>& ModelConfig::preset_names() {
   static const std::vector<std::string> names = {"paper", "small"};
@@ -50,6 +64,15 @@ void ModelConfig::validate() const {
   }
   if ((min_mass == 0.0) != (max_mass == 0.0)) {
     fail("min_mass", min_mass, "and max_mass must both be 0 (unknown) or both be > 0");
+  }
+  for (const auto& [name, range] :
+       {std::pair("friction", friction), std::pair("restitution", restitution),
+        std::pair("floor_friction", floor_friction),
+        std::pair("floor_restitution", floor_restitution)}) {
+    if (range.known() && !(range.lowest >= 0.0 && std::isfinite(range.highest))) {
+      throw ConfigError(fmt::format("model config: {} range [{}, {}] (must be finite and >= 0)",
+                                    name, range.lowest, range.highest));
+    }
   }
   if (!(time_step > 0.0) || !std::isfinite(time_step)) fail("time_step", time_step, "must be > 0");
   if (!gravity.allFinite()) fail("gravity", "non-finite", "must be finite");

@@ -20,6 +20,15 @@ Eigen::Index count_nodes(const Scene& scene) {
 
 }  // namespace
 
+bool familiar_material(const StaticProperties& body, const ModelConfig& config) {
+  return config.friction.holds(body.friction) && config.restitution.holds(body.restitution);
+}
+
+bool familiar_floor(const Floor& floor, const ModelConfig& config) {
+  return config.floor_friction.holds(floor.properties.friction) &&
+         config.floor_restitution.holds(floor.properties.restitution);
+}
+
 double mass_fit_factor(const Scene& scene, double min_mass, double max_mass) {
   if (!(min_mass > 0.0 && max_mass >= min_mass)) return 1.0;
   // The scene's dynamic masses as a span of logarithms.

@@ -99,16 +99,21 @@ struct FIGNetWorldOptions {
 
 // What the last internal step simulated and what it cost.
 struct FIGNetStepStats {
-  int simulated_bodies = 0;       // awake dynamic bodies predicted by the model
-  int free_flight_bodies = 0;     // awake dynamic bodies moved without it (no collision edge)
-  int sleeping_bodies = 0;        // dynamic bodies skipped because Bullet put them to sleep
-  int kinematic_objects = 0;      // static, kinematic and held bodies in contact range, no floor
-  int candidate_pairs = 0;        // broadphase pairs handed to the face-pair search
-  int face_edges = 0;             // face–face edges of the graph
-  int mesh_nodes = 0;             // mesh vertices in the network's graph (after the node budget)
-  int guarded_bodies = 0;         // bodies stopped by the tunnelling guard
-  int recovered_bodies = 0;       // bodies moved out of static geometry by the penetration guard
-  int rested_bodies = 0;          // awake bodies the rest guard kept still, without the network
+  int simulated_bodies = 0;    // awake dynamic bodies predicted by the model
+  int free_flight_bodies = 0;  // awake dynamic bodies moved without it (no collision edge)
+  int sleeping_bodies = 0;     // dynamic bodies skipped because Bullet put them to sleep
+  int kinematic_objects = 0;   // static, kinematic and held bodies in contact range, no floor
+  int candidate_pairs = 0;     // broadphase pairs handed to the face-pair search
+  int face_edges = 0;          // face–face edges of the graph
+  int mesh_nodes = 0;          // mesh vertices in the network's graph (after the node budget)
+  int guarded_bodies = 0;      // bodies stopped by the tunnelling guard
+  int recovered_bodies = 0;    // bodies moved out of static geometry by the penetration guard
+  int rested_bodies = 0;       // awake bodies the rest guard kept still, without the network
+  // Simulated bodies whose friction or restitution lie outside the model's training data's
+  // (ModelConfig::friction, restitution), and whether the floor in contact range does: there
+  // the model guesses. Always 0 and false for a model that does not record its data's materials.
+  int unfamiliar_bodies = 0;
+  bool unfamiliar_floor = false;
   double prepare_seconds = 0;     // broadphase, islands, meshes and histories
   double predict_seconds = 0;     // graph and network
   double write_back_seconds = 0;  // rigid fits and Bullet state

@@ -19,6 +19,18 @@ enum class NoiseKind {
             // drift that rollouts accumulate
 };
 
+// The range of one property over the training data's bodies: metadata, no parameter depends on
+// it. Empty (lowest > highest): unknown, as in model files from before it was recorded.
+struct DataRange {
+  double lowest = 1.0, highest = 0.0;
+
+  bool known() const { return lowest <= highest; }
+  // Widens the range to hold `value`.
+  void add(double value);
+  // Whether `value` lies within the range, up to float32 rounding of the data; true when unknown.
+  bool holds(double value) const;
+};
+
 struct ModelConfig {
   std::string preset = "paper";
   GraphConfig graph;
@@ -46,6 +58,11 @@ struct ModelConfig {
   // file from before they were recorded). Predictors bring a scene's masses within them by one
   // common factor (PredictionOptions::fit_masses).
   double min_mass = 0.0, max_mass = 0.0;
+  // The materials of the training data: friction and restitution of its bodies (dynamic and
+  // kinematic) and of its floor. MOVi-A's bodies are two materials on one floor, so a scene of
+  // other materials asks the model to guess; FIGNetDynamicsWorld counts such bodies
+  // (FIGNetStepStats::unfamiliar_bodies, unfamiliar_floor).
+  DataRange friction, restitution, floor_friction, floor_restitution;
   std::uint64_t seed = 0;  // parameter initialisation
 
   // "paper": L = 128, M = 10, d_c = 0.1 m (seed C.2). "small": L = 64, M = 5, about 10x fewer

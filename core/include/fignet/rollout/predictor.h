@@ -81,6 +81,11 @@ struct MassRange {
 // dynamic body, or when the range is unknown (0).
 double mass_fit_factor(const Scene& scene, double min_mass, double max_mass);
 
+// Whether a body's material, or a floor's, lies within the model's training data's (ModelConfig's
+// ranges; an unknown range holds every value). Outside them the model guesses.
+bool familiar_material(const StaticProperties& body, const ModelConfig& config);
+bool familiar_floor(const Floor& floor, const ModelConfig& config);
+
 // Runs a FIGNet model: builds the graph, runs the network, un-normalises. One per thread.
 class ModelPredictor : public AccelerationPredictor {
  public:
