@@ -15,6 +15,11 @@ def test_a_loaded_model_describes_itself(model):
     assert abs(model.time_step - 1 / 48) < 1e-12
     np.testing.assert_array_equal(model.gravity, [0, 0, -10])
     assert "small" in repr(model)
+    # The shipped model records its data's materials: MOVi-A's metal and rubber, Kubric's floor.
+    np.testing.assert_allclose(model.config["friction"], (0.4, 0.8), rtol=1e-6)
+    np.testing.assert_allclose(model.config["restitution"], (0.3, 0.7), rtol=1e-6)
+    np.testing.assert_allclose(model.config["floor_friction"], (0.3, 0.3), rtol=1e-6)
+    np.testing.assert_allclose(model.config["floor_restitution"], (0.5, 0.5), rtol=1e-6)
 
 
 def test_evaluation_equals_fignet_eval_on_the_same_file(tmp_path, cli, model, source_dir):
