@@ -33,13 +33,9 @@ py::dict config_of(const Model& model) {
   out["min_mass"] = model.config().min_mass;  // the training data's masses, kg (0: unknown)
   out["max_mass"] = model.config().max_mass;
   // The training data's materials: (lowest, highest), or None where the file does not record them.
-  const ModelConfig& c = model.config();
-  for (const auto& [name, range] :
-       {std::pair("friction", c.friction), std::pair("restitution", c.restitution),
-        std::pair("floor_friction", c.floor_friction),
-        std::pair("floor_restitution", c.floor_restitution)}) {
+  for (const auto& [name, range] : model.config().material_ranges()) {
     out[py::str(name)] =
-        range.known() ? py::object(py::make_tuple(range.lowest, range.highest)) : py::none();
+        range->known() ? py::object(py::make_tuple(range->lowest, range->highest)) : py::none();
   }
   return out;
 }

@@ -3,10 +3,6 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <array>
-#include <type_traits>
-#include <utility>
-
 #include "fignet/error.h"
 #include "hdf5_util.h"
 #include "model_contents.h"
@@ -34,17 +30,6 @@ auto named(N& n, const Network& network) {
   return result;
 }
 
-// The training data's material ranges by attribute name (min_NAME, max_NAME; optional).
-template <typename Config>
-auto material_ranges(Config& c) {
-  using Range = std::conditional_t<std::is_const_v<Config>, const DataRange, DataRange>;
-  return std::array<std::pair<const char*, Range*>, 4>{
-      {{"friction", &c.friction},
-       {"restitution", &c.restitution},
-       {"floor_friction", &c.floor_friction},
-       {"floor_restitution", &c.floor_restitution}}};
-}
-
 void write_config(H5::Group group, const ModelConfig& c) {
   using hdf5::write_attribute;
   write_attribute(group, "preset", c.preset);
@@ -60,8 +45,9 @@ void write_config(H5::Group group, const ModelConfig& c) {
   write_attribute(group, "mesh_vertices", static_cast<long long>(c.mesh_vertices));
   write_attribute(group, "min_mass", c.min_mass);
   write_attribute(group, "max_mass", c.max_mass);
-  for (const auto& [name, range] : material_ranges(c)) {
-    if (!range->known()) continue;  // absent: unknown
+  // The training data's materials as min_NAME and max_NAME, absent when unknown.
+  for (const auto& [name, range] : c.material_ranges()) {
+    if (!range->known()) continue;
     write_attribute(group, fmt::format("min_{}", name), range->lowest);
     write_attribute(group, fmt::format("max_{}", name), range->highest);
   }
@@ -106,7 +92,7 @@ ModelConfig read_config(const H5::Group& group) {
     c.min_mass = read_double(group, "min_mass");
     c.max_mass = read_double(group, "max_mass");
   }
-  for (const auto& [name, range] : material_ranges(c)) {
+  for (const auto& [name, range] : c.material_ranges()) {
     const std::string low = fmt::format("min_{}", name), high = fmt::format("max_{}", name);
     if (group.attrExists(low) && group.attrExists(high)) {
       range->lowest = read_double(group, low);

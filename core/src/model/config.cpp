@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 
 #include "fignet/error.h"
 
@@ -65,13 +64,10 @@ void ModelConfig::validate() const {
   if ((min_mass == 0.0) != (max_mass == 0.0)) {
     fail("min_mass", min_mass, "and max_mass must both be 0 (unknown) or both be > 0");
   }
-  for (const auto& [name, range] :
-       {std::pair("friction", friction), std::pair("restitution", restitution),
-        std::pair("floor_friction", floor_friction),
-        std::pair("floor_restitution", floor_restitution)}) {
-    if (range.known() && !(range.lowest >= 0.0 && std::isfinite(range.highest))) {
+  for (const auto& [name, range] : material_ranges()) {
+    if (range->known() && !(range->lowest >= 0.0 && std::isfinite(range->highest))) {
       throw ConfigError(fmt::format("model config: {} range [{}, {}] (must be finite and >= 0)",
-                                    name, range.lowest, range.highest));
+                                    name, range->lowest, range->highest));
     }
   }
   if (!(time_step > 0.0) || !std::isfinite(time_step)) fail("time_step", time_step, "must be > 0");

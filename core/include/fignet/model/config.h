@@ -2,9 +2,11 @@
 // physical setting it was trained in — in one struct, saved in and checked against model files.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "fignet/geometry/types.h"
@@ -63,6 +65,20 @@ struct ModelConfig {
   // other materials asks the model to guess; FIGNetDynamicsWorld counts such bodies
   // (FIGNetStepStats::unfamiliar_bodies, unfamiliar_floor).
   DataRange friction, restitution, floor_friction, floor_restitution;
+  // The four material ranges by name ("friction", ..., "floor_restitution"): one list for model
+  // files, validation and bindings.
+  std::array<std::pair<const char*, const DataRange*>, 4> material_ranges() const {
+    return {{{"friction", &friction},
+             {"restitution", &restitution},
+             {"floor_friction", &floor_friction},
+             {"floor_restitution", &floor_restitution}}};
+  }
+  std::array<std::pair<const char*, DataRange*>, 4> material_ranges() {
+    return {{{"friction", &friction},
+             {"restitution", &restitution},
+             {"floor_friction", &floor_friction},
+             {"floor_restitution", &floor_restitution}}};
+  }
   std::uint64_t seed = 0;  // parameter initialisation
 
   // "paper": L = 128, M = 10, d_c = 0.1 m (seed C.2). "small": L = 64, M = 5, about 10x fewer
