@@ -656,9 +656,13 @@ struct FIGNetDynamicsWorld::Impl {
   };
 
   // The penetration guard (after write_back): a body deeper than the tolerance in static
-  // geometry moves out along the contact normal, history included, so the network does not see
-  // the correction as velocity; the inward part of its velocity goes. A few passes let a body
-  // wedged against two surfaces leave both.
+  // geometry moves out along the contact normal to the tolerance, history included, so the
+  // network does not see the correction as velocity; the inward part of its velocity goes. Out
+  // to the tolerance, not to zero depth: a model that sinks a resting body slowly has it held
+  // where it reaches the tolerance, a few hundredths of a millimetre a frame, rather than popped
+  // up by the whole tolerance each time it crosses it. A few passes let a body wedged against two
+  // surfaces leave both.
+  static constexpr double kDepthSlack = 1e-5;  // metres; Bullet's depths are single precision
   void recover_static_penetrations(btCollisionWorld& world) {
     if (!options.penetration_guard) return;
     for (btRigidBody* body : moving) {
@@ -667,8 +671,9 @@ struct FIGNetDynamicsWorld::Impl {
       for (int pass = 0; pass < 4; ++pass) {
         StaticPenetration contact(body);
         world.contactTest(body, contact);
-        if (contact.depth <= options.penetration_tolerance) break;
-        const Vec3 push = contact.depth * contact.out;
+        // The slack keeps a body the last pass left at the tolerance from counting again.
+        if (contact.depth <= options.penetration_tolerance + kDepthSlack) break;
+        const Vec3 push = (contact.depth - options.penetration_tolerance) * contact.out;
         for (Pose& pose : state.poses) pose.position += push;
         // v' = v − min(0, v·n)·n, v the history's last velocity (what write_back gave Bullet);
         // the previous poses shift to match it.

@@ -485,6 +485,40 @@ TEST(FIGNetWorld, ThePenetrationGuardHoldsAFallingModelOnStaticGeometry) {
   }
 }
 
+// A model that sinks a resting body slowly (a small downward acceleration, as a model's bias at
+// rest) has it held where it reaches the tolerance, not popped up by the whole tolerance each
+// time it crosses it: once it is there it stops, and no frame moves it up by more than the
+// model moved it down.
+TEST(FIGNetWorld, ThePenetrationGuardHoldsASlowlySinkingBodyWithoutJumps) {
+  FIGNetWorldOptions options;
+  options.rest_guard = false;
+  options.allow_gravity_mismatch = true;
+  WorldFixture fixture(std::make_unique<GravityPredictor>(Vec3(0, 0, -0.2), WorldFixture::kStep),
+                       {}, options);
+  fixture.add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0, Pose{});
+  const btVector3 half(0.2f, 0.3f, 0.25f);
+  btRigidBody* box =
+      fixture.add(std::make_unique<btBoxShape>(half), 1.0, at(Vec3(0.5, -0.3, double(half.z()))));
+  box->setActivationState(DISABLE_DEACTIVATION);
+  double largest_rise = 0.0, lowest = INFINITY;
+  int recovered = 0;
+  double previous = box->getWorldTransform().getOrigin().z();
+  for (int step = 0; step < 300; ++step) {
+    fixture.step();
+    const double height = box->getWorldTransform().getOrigin().z();
+    largest_rise = std::max(largest_rise, height - previous);
+    previous = height;
+    lowest = std::min(lowest, lowest_corner(*box, half));
+    recovered += fixture.world.last_step_stats().recovered_bodies;
+  }
+  EXPECT_GT(recovered, 250);  // held at the tolerance from the first ~12 frames on
+  EXPECT_GT(lowest, -options.penetration_tolerance - 1e-4);
+  EXPECT_LT(lowest, -options.penetration_tolerance + 1e-3);
+  // Pushed out to zero depth it would rise 5 mm in a frame every time it crossed.
+  EXPECT_LT(largest_rise, 1e-3);
+  EXPECT_NEAR(box->getLinearVelocity().z(), 0.0, 0.2 * WorldFixture::kStep + 1e-4);
+}
+
 // A small untrained model (its answers are arbitrary but deterministic) on boxes `clearance`
 // above a static plane.
 struct ModelScene {

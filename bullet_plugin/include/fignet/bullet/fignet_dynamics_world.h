@@ -43,8 +43,9 @@ struct FIGNetWorldOptions {
   bool sleeping = true;
   // The penetration guard: after the learned step, a body that penetrates static geometry (planes,
   // triangle meshes, convex shapes) deeper than penetration_tolerance is moved out along the
-  // contact normal and loses the inward part of its velocity, as Bullet's split-impulse recovery
-  // does for its own solver. Depths are Bullet's contact distances (collision margins included).
+  // contact normal to the tolerance and loses the inward part of its velocity, as Bullet's
+  // split-impulse recovery does for its own solver: a model that sinks a body slowly has it held
+  // there, without jumps. Depths are Bullet's contact distances (collision margins included).
   bool penetration_guard = true;
   double penetration_tolerance = 0.005;  // metres
   // The rest guard, Coulomb's static friction under gravity. A body stays where it is when
