@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
 #include <random>
 
 #include "fignet/nn/adam.h"
@@ -143,6 +145,43 @@ TEST(Adam, DecaysTheLearningRateExponentiallyAndMinimisesAQuadratic) {
   }
   EXPECT_FLOAT_EQ(adam.learning_rate(), 1e-2f);  // held after decay_steps
   EXPECT_LT(std::abs(x[0]) + std::abs(x[1]), 0.05f);
+}
+
+// The update runs on the threads in fixed blocks: the same bits for 1 and 3 threads, over
+// several blocks and a partial one, and each parameter as Adam's formula in double precision
+// gives it (to float rounding).
+TEST(Adam, ThreadedUpdatesGiveTheSameBitsAsOneThreadAndFollowTheFormula) {
+  const size_t n = 3 * Adam::kParallelBlock + 17;
+  std::mt19937 rng(11);
+  std::normal_distribution<float> normal;
+  std::vector<float> start(n), g1(n), g2(n);
+  for (size_t i = 0; i < n; ++i) start[i] = normal(rng), g1[i] = normal(rng), g2[i] = normal(rng);
+  const AdamConfig config{.learning_rate_start = 1e-2f, .learning_rate_end = 1e-3f,
+                          .decay_steps = 10};
+  std::vector<std::vector<float>> results;
+  const int saved = omp_get_max_threads();
+  for (const int threads : {1, 3}) {
+    omp_set_num_threads(threads);
+    Adam adam(n, config);
+    std::vector<float> x = start;
+    adam.update(x, g1);
+    adam.update(x, g2);
+    results.push_back(x);
+  }
+  omp_set_num_threads(saved);
+  EXPECT_EQ(results[0], results[1]);
+  const double rate0 = 1e-2, rate1 = 1e-2 * std::pow(0.1, 0.1);  // decay over 10 steps
+  for (size_t i : {size_t(0), Adam::kParallelBlock - 1, Adam::kParallelBlock, n - 1}) {
+    double x = start[i], m = 0, v = 0;
+    const double grads[2] = {g1[i], g2[i]}, rates[2] = {rate0, rate1};
+    for (int t = 1; t <= 2; ++t) {
+      m = 0.9 * m + 0.1 * grads[t - 1];
+      v = 0.999 * v + 0.001 * grads[t - 1] * grads[t - 1];
+      const double m_hat = m / (1 - std::pow(0.9, t)), v_hat = v / (1 - std::pow(0.999, t));
+      x -= rates[t - 1] * m_hat / (std::sqrt(v_hat) + 1e-8);
+    }
+    EXPECT_NEAR(results[0][i], x, 1e-6 * (1 + std::abs(x))) << "parameter " << i;
+  }
 }
 
 }  // namespace

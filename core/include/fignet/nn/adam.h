@@ -21,8 +21,10 @@ class Adam {
   Adam() = default;
   Adam(size_t num_parameters, const AdamConfig& config);
 
-  // One update of `params` from `grads`; increments step().
+  // One update of `params` from `grads`, on the OpenMP threads in blocks of kParallelBlock
+  // parameters (the same bits for any thread count); increments step().
   // Throws ConfigError when either size differs from the optimizer's.
+  static constexpr size_t kParallelBlock = 16384;
   void update(std::span<float> params, std::span<const float> grads);
   float learning_rate() const;  // the rate the next update() will use
   std::int64_t step() const { return step_; }
