@@ -51,5 +51,21 @@ TEST(ParallelFor, ATeamOfOneRunsOnTheCallersThreadWithoutARegion) {
   EXPECT_EQ(level_inside, omp_get_level());
 }
 
+// Fixed blocks: the same [begin, end) ranges for any thread count, covering [0, n) once, the last
+// one partial.
+TEST(ParallelForBlocks, CoversEveryIndexOnceInTheSameBlocksForAnyThreadCount) {
+  const size_t n = 2 * 100 + 7;
+  for (const int threads : {1, 3}) {
+    std::vector<int> visits(n, 0);
+    std::vector<std::pair<size_t, size_t>> ranges(3);
+    parallel_for_blocks(n, 100, threads, [&](size_t begin, size_t end) {
+      ranges[begin / 100] = {begin, end};
+      for (size_t i = begin; i < end; ++i) ++visits[i];
+    });
+    EXPECT_EQ(visits, std::vector<int>(n, 1)) << threads << " threads";
+    EXPECT_EQ(ranges, (std::vector<std::pair<size_t, size_t>>{{0, 100}, {100, 200}, {200, 207}}));
+  }
+}
+
 }  // namespace
 }  // namespace fignet::detail

@@ -36,21 +36,19 @@ void Adam::update(std::span<float> params, std::span<const float> grads) {
   // Fixed blocks shared among the threads: each block runs the same code whatever the thread
   // count, so the parameters do not depend on it. Threads pay where a step is short (a GPU's at
   // batch 8 spent as long in this loop, on one thread, as in the network).
-  const size_t n = params.size();
-  const int blocks = static_cast<int>((n + kParallelBlock - 1) / kParallelBlock);
   float* p = params.data();
   float* m = m_.data();
   float* v = v_.data();
   const float* g = grads.data();
   const float beta1 = config_.beta1, beta2 = config_.beta2, epsilon = config_.epsilon;
-  detail::parallel_for(blocks, omp_get_max_threads(), detail::Schedule::kContiguous, [&](int b) {
-    const size_t end = std::min(n, (static_cast<size_t>(b) + 1) * kParallelBlock);
-    for (size_t i = static_cast<size_t>(b) * kParallelBlock; i < end; ++i) {
-      m[i] = beta1 * m[i] + (1.0f - beta1) * g[i];
-      v[i] = beta2 * v[i] + (1.0f - beta2) * g[i] * g[i];
-      p[i] -= step_size * m[i] / (std::sqrt(v[i]) * inv_sqrt_correction2 + epsilon);
-    }
-  });
+  detail::parallel_for_blocks(
+      params.size(), kParallelBlock, omp_get_max_threads(), [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) {
+          m[i] = beta1 * m[i] + (1.0f - beta1) * g[i];
+          v[i] = beta2 * v[i] + (1.0f - beta2) * g[i] * g[i];
+          p[i] -= step_size * m[i] / (std::sqrt(v[i]) * inv_sqrt_correction2 + epsilon);
+        }
+      });
 }
 
 }  // namespace fignet

@@ -6,6 +6,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <exception>
 #include <type_traits>
 
@@ -50,6 +51,18 @@ void parallel_for(int n, int threads, Schedule schedule, Body&& body) {
     for (int i = 0; i < n; ++i) run(i);
   }
   if (failure) std::rethrow_exception(failure);
+}
+
+// body(begin, end) over [0, n) in fixed blocks of `block` indices shared among `threads`: each
+// index is handled by the same code whatever the thread count, so elementwise results do not
+// depend on it.
+template <class Body>  // void(size_t begin, size_t end)
+void parallel_for_blocks(size_t n, size_t block, int threads, Body&& body) {
+  const int blocks = static_cast<int>((n + block - 1) / block);
+  parallel_for(blocks, threads, Schedule::kContiguous, [&](int b) {
+    const size_t begin = static_cast<size_t>(b) * block;
+    body(begin, std::min(n, begin + block));
+  });
 }
 
 }  // namespace fignet::detail

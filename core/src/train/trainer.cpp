@@ -352,14 +352,12 @@ void Trainer::update_average() {
   float* average = averaged_params_.data();
   const float* current = params_.data();
   // In Adam's fixed blocks, for the same reason (and the same bits for any thread count).
-  const size_t n = params_.size(), block = Adam::kParallelBlock;
-  const int blocks = static_cast<int>((n + block - 1) / block);
-  detail::parallel_for(blocks, omp_get_max_threads(), detail::Schedule::kContiguous, [&](int b) {
-    const size_t end = std::min(n, (static_cast<size_t>(b) + 1) * block);
-    for (size_t i = static_cast<size_t>(b) * block; i < end; ++i) {
-      average[i] = decay * average[i] + rate * current[i];
-    }
-  });
+  detail::parallel_for_blocks(params_.size(), Adam::kParallelBlock, omp_get_max_threads(),
+                              [&](size_t begin, size_t end) {
+                                for (size_t i = begin; i < end; ++i) {
+                                  average[i] = decay * average[i] + rate * current[i];
+                                }
+                              });
 }
 
 TrainerState Trainer::state() const {
