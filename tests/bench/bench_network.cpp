@@ -3,8 +3,9 @@
 // the same run:
 //   gflops         achieved by the network (FLOPs counted by Network::forward_flops; a
 //                  training step counts 3x the forward)
-//   sgemm_gflops   oneDNN's SGEMM (Eigen's without oneDNN) on the network's dominant shape,
-//                  mesh edges x L times L x L, with the same threads; ratio = gflops / that
+//   sgemm_gflops   gemm() with the build's engine (oneDNN: its matmul primitive for full blocks
+//                  of rows, sgemm for the rest; Eigen without oneDNN) on the network's dominant
+//                  shape, mesh edges x L times L x L, with the same threads; ratio = gflops / that
 //   eigen_gflops   Eigen's SGEMM on the same shape (the products' engine before oneDNN)
 //   peak_gflops    the processor's fp32 peak: independent FMA chains on the widest vectors it
 //                  has (AVX-512 or AVX2, chosen at run time) on every thread; of_peak = gflops /

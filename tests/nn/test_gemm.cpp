@@ -1,5 +1,6 @@
 // gemm() against a double-precision product, for every engine the build has, every transpose,
-// assignment and accumulation, column blocks of wider matrices and empty dimensions.
+// assignment and accumulation, column blocks of wider matrices and empty dimensions; gemm_bias()
+// against a double-precision Linear layer.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -147,6 +148,71 @@ TEST_P(Gemm, RowProductsGiveTheSameBitsForAnyThreadCount) {
                                           random_matrix(k, 128, 5), random_matrix(2401, 128, 6),
                                           1e-5 * k);
   }
+}
+
+// A Linear layer's product with its bias and activation, the rows of full blocks (which oneDNN
+// runs through its matmul primitive with fused post-ops) and of a partial last block (sgemm and a
+// pass) alike: within float rounding of the double product, then the bias, then max(·, 0).
+TEST_P(Gemm, BiasAndReluMatchADoublePrecisionLinearLayer) {
+  const EngineScope scope(GetParam());
+  const int shapes[][3] = {{256, 64, 64}, {549, 64, 64}, {300, 128, 3}, {77, 3, 64}, {512, 16, 8}};
+  unsigned seed = 100;
+  for (const auto& shape : shapes) {
+    const int m = shape[0], k = shape[1], n = shape[2];
+    for (Transpose tb : {Transpose::kNo, Transpose::kYes}) {
+      for (Activation activation : {Activation::kNone, Activation::kRelu}) {
+        SCOPED_TRACE(::testing::Message()
+                     << m << "x" << k << "x" << n << " tb " << (tb == Transpose::kYes) << " relu "
+                     << (activation == Activation::kRelu));
+        const RowMatrixXf a = random_matrix(m, k, seed++);
+        const RowMatrixXf b =
+            tb == Transpose::kNo ? random_matrix(k, n, seed++) : random_matrix(n, k, seed++);
+        const RowMatrixXf bias = random_matrix(1, n, seed++);
+        const MatrixXdRow b_op = tb == Transpose::kNo ? MatrixXdRow(b.cast<double>())
+                                                      : MatrixXdRow(b.cast<double>().transpose());
+        MatrixXdRow expected = a.cast<double>() * b_op;
+        expected.rowwise() += bias.cast<double>().row(0);
+        if (activation == Activation::kRelu) expected = expected.cwiseMax(0.0);
+        RowMatrixXf c = random_matrix(m, n, seed++);  // overwritten, never read
+        gemm_bias(a, b, tb, bias.data(), activation, c);
+        EXPECT_LT((c.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-5 * (k + 10));
+      }
+    }
+  }
+}
+
+// The MLPs' products read and write column blocks of wider matrices too; the bias and ReLU then
+// touch the block's columns only.
+TEST_P(Gemm, BiasAndReluWorkOnColumnBlocksOfWiderMatrices) {
+  const EngineScope scope(GetParam());
+  const RowMatrixXf wide_a = random_matrix(300, 3 * 16, 1), b = random_matrix(16, 8, 2);
+  const RowMatrixXf bias = random_matrix(1, 8, 3);
+  RowMatrixXf wide_c = random_matrix(300, 3 * 8, 4);
+  const RowMatrixXf before = wide_c;
+  gemm_bias(wide_a.middleCols(16, 16), b, Transpose::kNo, bias.data(), Activation::kRelu,
+            wide_c.middleCols(8, 8));
+  RowMatrixXf expected = wide_a.middleCols(16, 16) * b;
+  expected.rowwise() += bias.row(0);
+  expected = expected.cwiseMax(0.0f);
+  EXPECT_LT((wide_c.middleCols(8, 8) - expected).cwiseAbs().maxCoeff(), 1e-5);
+  EXPECT_EQ(wide_c.leftCols(8), before.leftCols(8));
+  EXPECT_EQ(wide_c.rightCols(8), before.rightCols(8));
+}
+
+// Each row's bits depend on its block, not on how many threads share the blocks.
+TEST_P(Gemm, BiasAndReluGiveTheSameBitsForAnyThreadCount) {
+  const EngineScope scope(GetParam());
+  const RowMatrixXf a = random_matrix(1500, 64, 5), b = random_matrix(64, 64, 6);
+  const RowMatrixXf bias = random_matrix(1, 64, 7);
+  auto run = [&](int threads) {
+    Eigen::setNbThreads(threads);
+    RowMatrixXf c(a.rows(), b.cols());
+    gemm_bias(a, b, Transpose::kNo, bias.data(), Activation::kRelu, c);
+    Eigen::setNbThreads(0);
+    return c;
+  };
+  const RowMatrixXf one = run(1);
+  for (int threads = 2; threads <= 4; ++threads) EXPECT_EQ(run(threads), one) << threads;
 }
 
 INSTANTIATE_TEST_SUITE_P(Engines, Gemm, ::testing::Values(GemmEngine::kEigen, GemmEngine::kOneDnn),

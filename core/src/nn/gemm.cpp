@@ -12,6 +12,8 @@
 
 #ifdef FIGNET_WITH_ONEDNN
 #include <oneapi/dnnl/dnnl.h>
+
+#include "nn/onednn_matmul.h"
 #endif
 
 namespace fignet {
@@ -161,25 +163,37 @@ void weight_gradient(GemmEngine engine, const ConstMatrixRef& a, const ConstMatr
 }
 
 // Rows of a block of a row product (below): enough for a one-thread product at full speed, few
-// enough that a scene's graph of a few thousand rows still shares out among threads.
+// enough that a scene's graph of a few thousand rows still shares out among threads. oneDNN
+// compiles a matmul primitive for this row count (per thread and shape), and blocks of it take
+// those.
 constexpr Eigen::Index kProductBlockRows = 256;
 
-// c (+)= a·op_b(b), each row of c a product of its own. A threaded sgemm splits the work in a way
-// that depends on the thread count, and on some kernels (oneDNN's avx2 ones) so do the rows' last
-// bits. Instead the rows are cut into blocks of kProductBlockRows, each block a one-thread product,
-// and the blocks shared among the threads: a row's bits depend only on its block, never on the
-// thread count.
+// c (+)= a·op_b(b), then c = act(c + bias) when `bias` is given; each row of c a product of its
+// own. A threaded sgemm splits the work in a way that depends on the thread count, and on some
+// kernels (oneDNN's avx2 ones) so do the rows' last bits. Instead the rows are cut into blocks of
+// kProductBlockRows, each block a one-thread product, and the blocks shared among the threads: a
+// row's bits depend only on its block, never on the thread count.
 void row_products(GemmEngine engine, const ConstMatrixRef& a, const ConstMatrixRef& b,
-                  Transpose op_b, MatrixRef c, bool accumulate) {
+                  Transpose op_b, MatrixRef c, bool accumulate, const float* bias,
+                  Activation activation) {
   const Eigen::Index m = c.rows();
   const Eigen::Index blocks = (m + kProductBlockRows - 1) / kProductBlockRows;
+  auto run_block = [&](int block) {
+    const Eigen::Index first = block * kProductBlockRows;
+    const Eigen::Index rows = std::min(kProductBlockRows, m - first);
+    const ConstMatrixRef a_rows = a.middleRows(first, rows);
+    MatrixRef c_rows = c.middleRows(first, rows);
+#ifdef FIGNET_WITH_ONEDNN
+    if (engine == GemmEngine::kOneDnn && rows == kProductBlockRows &&
+        detail::onednn_matmul_one_thread(a_rows, b, op_b, c_rows, accumulate, bias, activation)) {
+      return;
+    }
+#endif
+    gemm_one_thread(engine, a_rows, Transpose::kNo, b, op_b, c_rows, accumulate);
+    if (bias) bias_activation(c_rows, bias, activation, c_rows);
+  };
   detail::parallel_for(static_cast<int>(blocks), threads_for_blocks(),
-                       detail::Schedule::kContiguous, [&](int block) {
-                         const Eigen::Index first = block * kProductBlockRows;
-                         const Eigen::Index rows = std::min(kProductBlockRows, m - first);
-                         gemm_one_thread(engine, a.middleRows(first, rows), Transpose::kNo, b, op_b,
-                                         c.middleRows(first, rows), accumulate);
-                       });
+                       detail::Schedule::kContiguous, run_block);
 }
 
 #ifdef FIGNET_WITH_ONEDNN
@@ -225,7 +239,40 @@ void gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b, Tran
     weight_gradient(engine, a, b, op_b, c, accumulate);
     return;
   }
-  row_products(engine, a, b, op_b, c, accumulate);
+  row_products(engine, a, b, op_b, c, accumulate, nullptr, Activation::kNone);
+}
+
+void gemm_bias(const ConstMatrixRef& a, const ConstMatrixRef& b, Transpose op_b, const float* bias,
+               Activation activation, MatrixRef c) {
+  const Eigen::Index k = a.cols();
+  eigen_assert(c.rows() == a.rows());
+  eigen_assert(c.cols() == (op_b == Transpose::kNo ? b.cols() : b.rows()));
+  eigen_assert(k == (op_b == Transpose::kNo ? b.rows() : b.cols()));
+  if (c.rows() == 0 || c.cols() == 0) return;
+  if (k == 0) {
+    c.setZero();
+    bias_activation(c, bias, activation, c);
+    return;
+  }
+  row_products(current_engine().load(std::memory_order_relaxed), a, b, op_b, c, false, bias,
+               activation);
+}
+
+// The elementwise passes walk each row once while it is in L1, with plain loops over contiguous
+// columns that the compiler vectorises (Eigen's row-wise expressions on row-major matrices
+// re-read rows).
+void bias_activation(const ConstMatrixRef& x, const float* bias, Activation activation,
+                     MatrixRef out) {
+  const Eigen::Index cols = x.cols();
+  for (Eigen::Index r = 0; r < x.rows(); ++r) {
+    const float* in = x.row(r).data();
+    float* row = out.row(r).data();
+    if (activation == Activation::kRelu) {
+      for (Eigen::Index j = 0; j < cols; ++j) row[j] = std::max(in[j] + bias[j], 0.0f);
+    } else {
+      for (Eigen::Index j = 0; j < cols; ++j) row[j] = in[j] + bias[j];
+    }
+  }
 }
 
 GemmEngine gemm_engine() {

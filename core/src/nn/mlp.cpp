@@ -43,21 +43,10 @@ MatrixView Mlp::first_weight(float* params, int k) const {
 namespace {
 
 // The elementwise passes below walk each row once while it is in L1, with plain loops over
-// contiguous columns that the compiler vectorises (Eigen's row-wise expressions on row-major
-// matrices re-read rows and reduce columns with strided access). `omp simd reduction` lets the
-// row sums vectorise too: without it the compiler keeps their order and adds one float at a time.
+// contiguous columns that the compiler vectorises. `omp simd reduction` lets the row sums
+// vectorise too: without it the compiler keeps their order and adds one float at a time.
 
-// out = max(x + b, 0); x may be out.
-void bias_relu(const ConstMatrixRef& x, const float* b, MatrixRef out) {
-  const Eigen::Index cols = x.cols();
-  for (Eigen::Index r = 0; r < x.rows(); ++r) {
-    const float* in = x.row(r).data();
-    float* row = out.row(r).data();
-    for (Eigen::Index c = 0; c < cols; ++c) row[c] = std::max(in[c] + b[c], 0.0f);
-  }
-}
-
-// d *= (activation > 0), and db += Σ_rows d: the adjoint of bias_relu.
+// d *= (activation > 0), and db += Σ_rows d: the adjoint of a bias and ReLU.
 void relu_backward(MatrixRef d, const ConstMatrixRef& activation, float* db) {
   const Eigen::Index cols = d.cols();
   for (Eigen::Index r = 0; r < d.rows(); ++r) {
@@ -74,23 +63,17 @@ void relu_backward(MatrixRef d, const ConstMatrixRef& activation, float* db) {
 
 void Mlp::forward(const float* params, MatrixView first, MlpCache& cache, MatrixRef out) const {
   const Eigen::Index n = first.rows();
-  // Hidden layers: ReLU(x·W + b).
+  // Hidden layers: ReLU(x·W + b); the second's bias and ReLU run inside its product.
   MatrixView h1 = cache.hidden1.view(n, hidden_);
-  bias_relu(first, params + b0_, h1);
+  bias_activation(first, params + b0_, Activation::kRelu, h1);
   MatrixView h2 = cache.hidden2.view(n, hidden_);
-  gemm(h1, Transpose::kNo, tensor(params, w1_, hidden_, hidden_), Transpose::kNo, h2, false);
-  bias_relu(h2, params + b1_, h2);
-  gemm(h2, Transpose::kNo, tensor(params, w2_, hidden_, output_), Transpose::kNo, out, false);
-  const float* b2 = params + b2_;
-  if (!layer_norm_) {
-    for (Eigen::Index r = 0; r < n; ++r) {
-      float* y = out.row(r).data();
-      for (int c = 0; c < output_; ++c) y[c] += b2[c];
-    }
-    return;
-  }
-  // y = x·W2 + b2, then LayerNorm over each row: x̂ = (y − μ)/sqrt(σ² + ε),
-  // out = scale·x̂ + offset.
+  gemm_bias(h1, tensor(params, w1_, hidden_, hidden_), Transpose::kNo, params + b1_,
+            Activation::kRelu, h2);
+  // Output layer: y = x·W2 + b2.
+  gemm_bias(h2, tensor(params, w2_, hidden_, output_), Transpose::kNo, params + b2_,
+            Activation::kNone, out);
+  if (!layer_norm_) return;
+  // LayerNorm over each row: x̂ = (y − μ)/sqrt(σ² + ε), out = scale·x̂ + offset.
   MatrixView normalized = cache.normalized.view(n, output_);
   MatrixView inv_std = cache.inv_std.view(n, 1);
   const float* scale = params + scale_;
@@ -101,7 +84,7 @@ void Mlp::forward(const float* params, MatrixView first, MlpCache& cache, Matrix
     float* x_hat = normalized.row(r).data();
     float sum = 0.0f;
 #pragma omp simd reduction(+ : sum)
-    for (int c = 0; c < output_; ++c) sum += (y[c] += b2[c]);
+    for (int c = 0; c < output_; ++c) sum += y[c];
     const float mean = sum * inv_width;
     float squares = 0.0f;
 #pragma omp simd reduction(+ : squares)

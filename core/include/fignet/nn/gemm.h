@@ -11,6 +11,8 @@
 // (oneDNN's avx2 kernels change the last bits with it), so gemm() does the threading itself. Row
 // products are cut into fixed blocks of rows, each a one-thread product; the sums over a batch's
 // rows (op_a = kYes) into fixed blocks whose one-thread partials are added in block order.
+// On oneDNN the row products' full blocks run through its matmul primitive, compiled per shape
+// (brgemm kernels where the processor has them), with a Linear layer's bias and ReLU fused in.
 #pragma once
 
 #include <string>
@@ -21,11 +23,21 @@ namespace fignet {
 
 enum class GemmEngine { kEigen, kOneDnn };
 enum class Transpose { kNo, kYes };
+enum class Activation { kNone, kRelu };
 
 // c = op_a(a)·op_b(b), or c += op_a(a)·op_b(b) when `accumulate`. Shapes must agree (checked in
 // debug builds); an empty inner dimension gives zeros (or leaves c unchanged when accumulating).
 void gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b, Transpose op_b,
           MatrixRef c, bool accumulate);
+
+// c = act(a·op_b(b) + bias), a Linear layer's forward product: `bias` is a row of c.cols()
+// floats added to every row. On oneDNN the bias and ReLU run inside the product's kernel; on
+// Eigen, as one pass over c after it (bias_activation). Same threading and bits as gemm().
+void gemm_bias(const ConstMatrixRef& a, const ConstMatrixRef& b, Transpose op_b, const float* bias,
+               Activation activation, MatrixRef c);
+// out = act(x + bias), row by row; x may be out.
+void bias_activation(const ConstMatrixRef& x, const float* bias, Activation activation,
+                     MatrixRef out);
 
 // The engine gemm() uses: oneDNN where the build has it, unless the environment variable
 // FIGNET_GEMM=eigen (read once, at the first product) or set_gemm_engine() chose Eigen.
