@@ -163,9 +163,8 @@ void weight_gradient(GemmEngine engine, const ConstMatrixRef& a, const ConstMatr
 }
 
 // Rows of a block of a row product (below): enough for a one-thread product at full speed, few
-// enough that a scene's graph of a few thousand rows still shares out among threads. oneDNN
-// compiles a matmul primitive for this row count (per thread and shape), and blocks of it take
-// those.
+// enough that a scene's graph of a few thousand rows still shares out among threads. On oneDNN
+// the full blocks run on matmul primitives compiled for this row count.
 constexpr Eigen::Index kProductBlockRows = 256;
 
 // c (+)= a·op_b(b), then c = act(c + bias) when `bias` is given; each row of c a product of its
