@@ -225,6 +225,10 @@ TEST(GemmEngine, EigenIsAlwaysThereAndTheDescriptionNamesTheEngine) {
   if (gemm_engine_available(GemmEngine::kOneDnn)) {
     set_gemm_engine(GemmEngine::kOneDnn);
     EXPECT_EQ(gemm_description().rfind("oneDNN ", 0), 0u) << gemm_description();
+    // Says whether the full blocks run on brgemm kernels or everything on sgemm.
+    EXPECT_TRUE(gemm_description().find("matmul primitive (brg") != std::string::npos ||
+                gemm_description().find("on its sgemm") != std::string::npos)
+        << gemm_description();
   } else {
     EXPECT_THROW(set_gemm_engine(GemmEngine::kOneDnn), ConfigError);
   }

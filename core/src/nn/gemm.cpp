@@ -196,6 +196,15 @@ void row_products(GemmEngine engine, const ConstMatrixRef& a, const ConstMatrixR
 }
 
 #ifdef FIGNET_WITH_ONEDNN
+// Which oneDNN implementation runs the full blocks of row products here.
+std::string block_products_description() {
+  const std::string kernel = detail::onednn_block_kernel();
+  if (kernel.starts_with("brg")) {
+    return "full row blocks on its matmul primitive (" + kernel + ", bias and ReLU fused)";
+  }
+  return "every product on its sgemm (no brgemm matmul kernel for this processor)";
+}
+
 const char* isa_name(dnnl_cpu_isa_t isa) {
   switch (isa) {
     case dnnl_cpu_isa_sse41:
@@ -310,7 +319,7 @@ std::string gemm_description() {
   const dnnl_version_t* v = dnnl_version();
   return "oneDNN " + std::to_string(v->major) + "." + std::to_string(v->minor) + "." +
          std::to_string(v->patch) + ", kernels for " + isa_name(dnnl_get_effective_cpu_isa()) +
-         " (chosen at run time)";
+         " (chosen at run time); " + block_products_description();
 #else
   return "Eigen";
 #endif

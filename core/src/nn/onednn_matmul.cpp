@@ -106,6 +106,14 @@ CompiledMatmul compile(const MatmulKey& key) {
 
 }  // namespace
 
+std::string onednn_block_kernel() {
+  const OneOmpThread one_thread;
+  const dnnl::memory::desc block = describe(256, 64, 64, false);
+  const dnnl::memory::desc weights = describe(64, 64, 64, false);
+  return dnnl::matmul::primitive_desc(dnnl::matmul::desc(block, weights, block), cpu_engine())
+      .impl_info_str();
+}
+
 bool onednn_matmul_one_thread(const ConstMatrixRef& a, const ConstMatrixRef& b, Transpose op_b,
                               MatrixRef c, bool accumulate, const float* bias,
                               Activation activation) {

@@ -5,6 +5,8 @@
 // partial last block of a product goes through sgemm, whose kernels take any shape).
 #pragma once
 
+#include <string>
+
 #include "fignet/nn/buffer.h"
 #include "fignet/nn/gemm.h"
 
@@ -19,5 +21,9 @@ namespace fignet::detail {
 bool onednn_matmul_one_thread(const ConstMatrixRef& a, const ConstMatrixRef& b, Transpose op_b,
                               MatrixRef c, bool accumulate, const float* bias,
                               Activation activation);
+
+// oneDNN's implementation of the full blocks' primitive on this processor, e.g. "brg:avx512_core"
+// (brgemm kernels) or "gemm:jit" (its sgemm inside: gemm() then calls sgemm itself).
+std::string onednn_block_kernel();
 
 }  // namespace fignet::detail

@@ -48,7 +48,8 @@ bool gemm_engine_available(GemmEngine engine);
 // "oneDNN" or "Eigen".
 const char* gemm_engine_name(GemmEngine engine);
 // What runs the products, for `fignet info` and benchmark reports, e.g. "oneDNN 2.6.3, kernels
-// for avx512_core_bf16 (chosen at run time)" or "Eigen 3.4.0, AVX SSE2 ... (fixed at compile
+// for avx512_core_bf16 (chosen at run time); full row blocks on its matmul primitive
+// (brg:avx512_core, bias and ReLU fused)" or "Eigen 3.4.0, AVX SSE2 ... (fixed at compile
 // time)".
 std::string gemm_description();
 
