@@ -75,16 +75,11 @@ dnnl_status_t onednn_gemm_one_thread(const ConstMatrixRef& a, Transpose op_a,
                                      bool accumulate) {
   const Eigen::Index m = c.rows(), n = c.cols();
   const Eigen::Index k = op_a == Transpose::kNo ? a.cols() : a.rows();
-  // oneDNN's OpenMP runtime takes omp_get_max_threads(): one for this call, restored after.
-  const int threads_before = omp_get_max_threads();
-  if (threads_before != 1) omp_set_num_threads(1);
+  const detail::OneOmpThread one_thread;
   // Row-major throughout: oneDNN's sgemm takes row-major operands and leading dimensions.
-  const dnnl_status_t status =
-      dnnl_sgemm(op_a == Transpose::kNo ? 'N' : 'T', op_b == Transpose::kNo ? 'N' : 'T', m, n, k,
-                 1.0f, a.data(), a.outerStride(), b.data(), b.outerStride(),
-                 accumulate ? 1.0f : 0.0f, c.data(), c.outerStride());
-  if (threads_before != 1) omp_set_num_threads(threads_before);
-  return status;
+  return dnnl_sgemm(op_a == Transpose::kNo ? 'N' : 'T', op_b == Transpose::kNo ? 'N' : 'T', m, n, k,
+                    1.0f, a.data(), a.outerStride(), b.data(), b.outerStride(),
+                    accumulate ? 1.0f : 0.0f, c.data(), c.outerStride());
 }
 
 void check_onednn(dnnl_status_t status, Eigen::Index m, Eigen::Index k, Eigen::Index n) {

@@ -1,7 +1,5 @@
 #include "nn/onednn_matmul.h"
 
-#include <omp.h>
-
 #include <oneapi/dnnl/dnnl.hpp>
 #include <string>
 #include <unordered_map>
@@ -53,23 +51,6 @@ dnnl::memory::desc describe(Eigen::Index rows, Eigen::Index cols, Eigen::Index r
   return {dims{rows, cols}, dnnl::memory::data_type::f32,
           transposed ? dims{1, row_stride} : dims{row_stride, 1}};
 }
-
-// oneDNN's OpenMP runtime takes omp_get_max_threads() both when it plans a primitive's work and
-// when it runs it: one while this lives, the caller's setting restored after.
-class OneOmpThread {
- public:
-  OneOmpThread() : before_(omp_get_max_threads()) {
-    if (before_ != 1) omp_set_num_threads(1);
-  }
-  ~OneOmpThread() {
-    if (before_ != 1) omp_set_num_threads(before_);
-  }
-  OneOmpThread(const OneOmpThread&) = delete;
-  OneOmpThread& operator=(const OneOmpThread&) = delete;
-
- private:
-  int before_;
-};
 
 CompiledMatmul compile(const MatmulKey& key) {
   const dnnl::engine& engine = cpu_engine();

@@ -5,12 +5,31 @@
 // partial last block of a product goes through sgemm, whose kernels take any shape).
 #pragma once
 
+#include <omp.h>
+
 #include <string>
 
 #include "fignet/nn/buffer.h"
 #include "fignet/nn/gemm.h"
 
 namespace fignet::detail {
+
+// oneDNN's OpenMP runtime takes omp_get_max_threads() both when it plans a primitive's work and
+// when it runs it (sgemm included): one while this lives, the caller's setting restored after.
+class OneOmpThread {
+ public:
+  OneOmpThread() : before_(omp_get_max_threads()) {
+    if (before_ != 1) omp_set_num_threads(1);
+  }
+  ~OneOmpThread() {
+    if (before_ != 1) omp_set_num_threads(before_);
+  }
+  OneOmpThread(const OneOmpThread&) = delete;
+  OneOmpThread& operator=(const OneOmpThread&) = delete;
+
+ private:
+  int before_;
+};
 
 // c (+)= a·op_b(b), then c = act(c + bias) when `bias` is given (not with `accumulate`), on the
 // calling thread alone. Each thread compiles a primitive per shape, strides and epilogue at its
