@@ -7,6 +7,7 @@
 #include "../temp_folder.h"
 #include "fignet/error.h"
 #include "fignet/io/model_file.h"
+#include "hdf5_time_stamps.h"
 
 namespace fignet {
 namespace {
@@ -88,6 +89,10 @@ TEST_F(ModelFile, SaveThenLoadIsBitExact) {
   EXPECT_EQ(loaded.normalizers().mesh_node.accumulations(), 1);
   // No temporary file is left beside the model.
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+TEST_F(ModelFile, NoObjectCarriesATimeStamp) {
+  EXPECT_EQ(testing::objects_with_time_stamps(path_), std::vector<std::string>{});
 }
 
 // A byte flipped in the file's last half (parameters and statistics) loads as a valid model or

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "../io/hdf5_time_stamps.h"
 #include "../temp_folder.h"
 #include "fignet/error.h"
 #include "fignet/io/checkpoint.h"
@@ -63,6 +64,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   resumed.restore(checkpoint.state);
   resumed.run(6, nullptr);
 
+  EXPECT_EQ(testing::objects_with_time_stamps(dir_ / "run.ckpt.h5"), std::vector<std::string>{});
   EXPECT_EQ(resumed.steps_done(), 10);
   EXPECT_EQ(resumed.parameters(), uninterrupted.parameters());
   EXPECT_EQ(resumed.optimizer().second_moment(), uninterrupted.optimizer().second_moment());

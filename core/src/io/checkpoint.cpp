@@ -81,7 +81,7 @@ void save_checkpoint(const Trainer& trainer, const std::filesystem::path& path,
   const TrainerState state = trainer.state();
   hdf5::write_atomically(path, kWhat, [&](H5::H5File& file) {
     write_model_contents(file, *model);
-    H5::Group training = file.createGroup("training");
+    H5::Group training = hdf5::create_group(file, "training");
     write_training(training, trainer.trainer_config(), state);
     hdf5::write_attribute(training, "planned_steps", static_cast<long long>(planned_steps));
   });

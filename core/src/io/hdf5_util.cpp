@@ -32,10 +32,29 @@ std::vector<std::string> split(const std::string& path) {
 
 }  // namespace
 
+H5::Group create_group(const H5::Group& parent, const std::string& name) {
+  // HDF5's C++ API of Debian's 1.10 takes no group creation properties: create through C.
+  const hid_t properties = H5Pcreate(H5P_GROUP_CREATE);
+  H5Pset_obj_track_times(properties, false);
+  const hid_t id = H5Gcreate2(parent.getId(), name.c_str(), H5P_DEFAULT, properties, H5P_DEFAULT);
+  H5Pclose(properties);
+  if (id < 0) throw H5::GroupIException("create_group", "cannot create group '" + name + "'");
+  H5::Group group(id);  // holds a reference of its own
+  H5Gclose(id);
+  return group;
+}
+
+H5::DataSet create_dataset(const H5::Group& parent, const std::string& name,
+                           const H5::DataType& type, const H5::DataSpace& space) {
+  H5::DSetCreatPropList properties;
+  H5Pset_obj_track_times(properties.getId(), false);
+  return parent.createDataSet(name, type, space, properties);
+}
+
 H5::Group make_groups(H5::Group root, const std::string& path) {
   H5::Group group = root;
   for (const std::string& part : split(path)) {
-    group = group.nameExists(part) ? group.openGroup(part) : group.createGroup(part);
+    group = group.nameExists(part) ? group.openGroup(part) : create_group(group, part);
   }
   return group;
 }
@@ -95,7 +114,7 @@ void write_dataset(H5::Group& group, const std::string& path, const T* data,
   H5::Group parent = slash == std::string::npos ? group : make_groups(group, path.substr(0, slash));
   const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
   const H5::DataSpace space(static_cast<int>(shape.size()), shape.data());
-  parent.createDataSet(name, file, space).write(data, memory);
+  create_dataset(parent, name, file, space).write(data, memory);
 }
 
 void write_floats(H5::Group& group, const std::string& path, const float* data,
@@ -142,7 +161,9 @@ void write_atomically(const std::filesystem::path& path, const std::string& what
   temporary += fmt::format(".tmp-{}", ::getpid());
   try {
     {
-      H5::H5File file(temporary.string(), H5F_ACC_TRUNC);
+      H5::FileCreatPropList properties;  // the root group without a time stamp either
+      H5Pset_obj_track_times(properties.getId(), false);
+      H5::H5File file(temporary.string(), H5F_ACC_TRUNC, properties);
       write(file);
     }  // closed (and flushed) before the rename
     std::filesystem::rename(temporary, path);

@@ -11,6 +11,13 @@
 
 namespace fignet::hdf5 {
 
+// Every object this library writes is created without the modification time HDF5 stamps on it by
+// default, so the same contents give the same bytes: data, models and checkpoints written twice
+// compare equal with cmp or a checksum.
+H5::Group create_group(const H5::Group& parent, const std::string& name);
+H5::DataSet create_dataset(const H5::Group& parent, const std::string& name,
+                           const H5::DataType& type, const H5::DataSpace& space);
+
 // Opens (creating as needed) every group along "a/b/c" below `root`.
 H5::Group make_groups(H5::Group root, const std::string& path);
 bool exists(const H5::Group& root, const std::string& path);

@@ -156,15 +156,15 @@ void write_model_contents(H5::H5File& file, const Model& model) {
   H5::Group root = file.openGroup("/");
   hdf5::write_attribute(root, "format", std::string(kFormat));
   hdf5::write_attribute(root, "version", kModelFileVersion);
-  write_config(file.createGroup("config"), model.config());
-  H5::Group parameters = file.createGroup("parameters");
+  write_config(hdf5::create_group(file, "config"), model.config());
+  H5::Group parameters = hdf5::create_group(file, "parameters");
   for (const TensorInfo& t : model.network().layout().tensors()) {
     hdf5::write_floats(parameters, t.name, model.parameters().data() + t.offset,
                        {static_cast<hsize_t>(t.rows), static_cast<hsize_t>(t.cols)});
   }
-  H5::Group normalizers = file.createGroup("normalizers");
+  H5::Group normalizers = hdf5::create_group(file, "normalizers");
   for (const auto& [name, normalizer] : named(model.normalizers(), model.network())) {
-    H5::Group group = normalizers.createGroup(name);
+    H5::Group group = hdf5::create_group(normalizers, name);
     hdf5::write_attribute(group, "accumulations",
                           static_cast<long long>(normalizer->accumulations()));
     hdf5::write_attribute(group, "count", normalizer->count());

@@ -38,7 +38,7 @@ void write_object(H5::Group group, const TrajectoryObject& object) {
   hdf5::write_doubles(group, "rest_vertices", mesh.vertices().data(),
                       {size(mesh.num_vertices()), 3});
   const H5::DataSpace space(2, std::vector<hsize_t>{size(mesh.num_faces()), 3}.data());
-  group.createDataSet("faces", H5::PredType::STD_I32LE, space)
+  hdf5::create_dataset(group, "faces", H5::PredType::STD_I32LE, space)
       .write(mesh.faces().data(), H5::PredType::NATIVE_INT32);
   const hsize_t frames = object.poses.size();
   Rows positions(frames, 3), orientations(frames, 4);
@@ -73,7 +73,7 @@ void write_trajectory(H5::Group group, const Trajectory& t) {
   }
   write_attribute(group, "num_objects", static_cast<long long>(t.objects.size()));
   for (size_t o = 0; o < t.objects.size(); ++o) {
-    write_object(group.createGroup(fmt::format("object_{}", o)), t.objects[o]);
+    write_object(hdf5::create_group(group, fmt::format("object_{}", o)), t.objects[o]);
   }
 }
 
@@ -189,9 +189,9 @@ void write_trajectories(const std::filesystem::path& path, std::span<const Traje
     hdf5::write_attribute(root, "seed", static_cast<long long>(info.seed));
     hdf5::write_attribute(root, "stacks", static_cast<long long>(info.stacks));
     hdf5::write_attribute(root, "num_trajectories", static_cast<long long>(trajectories.size()));
-    H5::Group group = file.createGroup("trajectories");
+    H5::Group group = hdf5::create_group(file, "trajectories");
     for (size_t i = 0; i < trajectories.size(); ++i) {
-      write_trajectory(group.createGroup(fmt::format("{:06d}", i)), trajectories[i]);
+      write_trajectory(hdf5::create_group(group, fmt::format("{:06d}", i)), trajectories[i]);
     }
   });
 }
