@@ -353,7 +353,7 @@ void Trainer::update_average() {
   const float* current = params_.data();
   // In Adam's fixed blocks, for the same reason (and the same bits for any thread count).
   detail::parallel_for_blocks(params_.size(), Adam::kParallelBlock, omp_get_max_threads(),
-                              [&](size_t begin, size_t end) {
+                              [=](size_t begin, size_t end) {
                                 for (size_t i = begin; i < end; ++i) {
                                   average[i] = decay * average[i] + rate * current[i];
                                 }
