@@ -90,10 +90,6 @@ TEST_F(TrajectoryFile, WriteThenReadRoundTripsExactly) {
   EXPECT_EQ(read_trajectories({dir_ / "set.h5", dir_ / "shard1.h5"}).size(), 5u);
 }
 
-// A byte flipped anywhere in the file's last half (the datasets' contents: vertices, faces,
-// poses) either reads back as a valid set or fails with a FileError: never another exception,
-// a crash, or an invalid trajectory. (Flips in HDF5's own metadata can hit libhdf5 bugs; see
-// docs/model-file.md and tests/fuzz.)
 // No object carries HDF5's time stamps: the same scenes written at another time are the same
 // bytes, so a data set regenerated from its seeds can be checked with a checksum.
 TEST_F(TrajectoryFile, SameTrajectoriesGiveTheSameBytes) {
@@ -105,6 +101,10 @@ TEST_F(TrajectoryFile, SameTrajectoriesGiveTheSameBytes) {
                          std::istreambuf_iterator<char>(b), std::istreambuf_iterator<char>()));
 }
 
+// A byte flipped anywhere in the file's last half (the datasets' contents: vertices, faces,
+// poses) either reads back as a valid set or fails with a FileError: never another exception,
+// a crash, or an invalid trajectory. (Flips in HDF5's own metadata can hit libhdf5 bugs; see
+// docs/model-file.md and tests/fuzz.)
 TEST_F(TrajectoryFile, FlippedBytesInTheDataFailCleanlyOrReadValid) {
   write_trajectories(dir_ / "set.h5", make_data(2), {"movi-a", "0.1.0", 7});
   std::string bytes;
