@@ -3,7 +3,9 @@
 // against a double-precision Linear layer.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
+#include <vector>
 
 #include "fignet/error.h"
 #include "fignet/nn/gemm.h"
@@ -213,6 +215,48 @@ TEST_P(Gemm, BiasAndReluGiveTheSameBitsForAnyThreadCount) {
   };
   const RowMatrixXf one = run(1);
   for (int threads = 2; threads <= 4; ++threads) EXPECT_EQ(run(threads), one) << threads;
+}
+
+// Row passes fused into a product: the prologue runs on every row of a before the product reads
+// it (here it doubles a's rows, written in place), the epilogue on every row of c after its
+// product, bias and ReLU (here it squares them), each row exactly once: the result is the
+// unfused computation's, bit for bit, for any thread count, over full blocks and a partial one.
+TEST_P(Gemm, RowPassesRunOnEveryRowOnceBeforeAndAfterItsProduct) {
+  const EngineScope scope(GetParam());
+  const RowMatrixXf source = random_matrix(700, 64, 8), b = random_matrix(64, 32, 9);
+  const RowMatrixXf bias = random_matrix(1, 32, 10);
+  RowMatrixXf expected(source.rows(), b.cols());
+  gemm_bias(2.0f * source, b, Transpose::kNo, bias.data(), Activation::kRelu, expected);
+  expected = expected.cwiseProduct(expected);
+
+  struct Passes {
+    const RowMatrixXf* source;
+    RowMatrixXf* a;
+    RowMatrixXf* c;
+    std::vector<int>* before;  // per row: 1 once the prologue ran, 2 once the epilogue did
+  };
+  auto prologue = [](const void* context, Eigen::Index first, Eigen::Index rows) {
+    const auto& p = *static_cast<const Passes*>(context);
+    p.a->middleRows(first, rows) = 2.0f * p.source->middleRows(first, rows);
+    for (Eigen::Index r = first; r < first + rows; ++r) (*p.before)[r] += 1;
+  };
+  auto epilogue = [](const void* context, Eigen::Index first, Eigen::Index rows) {
+    const auto& p = *static_cast<const Passes*>(context);
+    p.c->middleRows(first, rows) = p.c->middleRows(first, rows).cwiseAbs2();
+    for (Eigen::Index r = first; r < first + rows; ++r) (*p.before)[r] += 10;
+  };
+  for (int threads = 1; threads <= 4; ++threads) {
+    Eigen::setNbThreads(threads);
+    RowMatrixXf a = RowMatrixXf::Constant(source.rows(), source.cols(), 1e30f);  // unread until set
+    RowMatrixXf c(source.rows(), b.cols());
+    std::vector<int> visits(source.rows(), 0);
+    const Passes passes{&source, &a, &c, &visits};
+    gemm_bias(a, b, Transpose::kNo, bias.data(), Activation::kRelu, c, {+prologue, &passes},
+              {+epilogue, &passes});
+    Eigen::setNbThreads(0);
+    EXPECT_EQ(c, expected) << threads << " threads";
+    EXPECT_EQ(std::count(visits.begin(), visits.end(), 11), source.rows()) << threads;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Engines, Gemm, ::testing::Values(GemmEngine::kEigen, GemmEngine::kOneDnn),

@@ -110,6 +110,68 @@ TEST(Mlp, LayerNormOutputHasZeroMeanUnitVariancePerRow) {
   }
 }
 
+// The forward pass over rows of several product blocks (the full ones run through oneDNN's
+// primitive, the last partial one through sgemm; the first layer's ReLU and LayerNorm run on each
+// block as the products reach it), into a column block of a wider matrix: against the MLP in
+// double precision from its parameters, the neighbouring columns untouched, and the same bits
+// for any thread count.
+TEST(Mlp, ForwardOverManyBlocksMatchesADoublePrecisionMlpForAnyThreadCount) {
+  using MatrixXdRow = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  constexpr int kRows = 700, kInput = 12, kHidden = 64, kOutput = 64;
+  ParameterLayout layout;
+  const Mlp mlp(layout, "mlp", {kInput}, kHidden, kOutput, true);
+  std::vector<float> params;
+  layout.initialize(params, 7);
+  std::mt19937 rng(8);
+  std::normal_distribution<float> perturbation(0.0f, 0.3f);
+  for (float& p : params) p += perturbation(rng);  // biases, scale and offset away from 0 and 1
+  const RowMatrixXf x = random_matrix(rng, kRows, kInput);
+
+  const MlpTensors t = mlp.tensors();
+  auto tensor_d = [&](size_t offset, int rows, int cols) {
+    return MatrixXdRow(
+        Eigen::Map<const RowMatrixXf>(params.data() + offset, rows, cols).cast<double>());
+  };
+  MatrixXdRow h = x.cast<double>() * tensor_d(t.w0, kInput, kHidden);
+  h = (h.rowwise() + tensor_d(t.b0, 1, kHidden).row(0)).cwiseMax(0.0);
+  h = h * tensor_d(t.w1, kHidden, kHidden);
+  h = (h.rowwise() + tensor_d(t.b1, 1, kHidden).row(0)).cwiseMax(0.0);
+  MatrixXdRow y = h * tensor_d(t.w2, kHidden, kOutput);
+  y.rowwise() += tensor_d(t.b2, 1, kOutput).row(0);
+  for (int r = 0; r < kRows; ++r) {
+    const double mean = y.row(r).mean();
+    const double variance = (y.row(r).array() - mean).square().mean();
+    y.row(r) = ((y.row(r).array() - mean) / std::sqrt(variance + Mlp::kLayerNormEpsilon))
+                   .matrix()
+                   .cwiseProduct(tensor_d(t.scale, 1, kOutput).row(0)) +
+               tensor_d(t.offset, 1, kOutput).row(0);
+  }
+
+  // Into a matrix of its own, and into the middle column block of a wider one.
+  for (const int blocks_beside : {0, 1}) {
+    SCOPED_TRACE(blocks_beside ? "column block" : "whole matrix");
+    const RowMatrixXf before = random_matrix(rng, kRows, (1 + 2 * blocks_beside) * kOutput);
+    auto run = [&](int threads) {
+      Eigen::setNbThreads(threads);
+      Buffer first;
+      MlpCache cache;
+      RowMatrixXf wide = before;
+      mlp.forward_dense(params.data(), x, first, cache,
+                        wide.middleCols(blocks_beside * kOutput, kOutput));
+      Eigen::setNbThreads(0);
+      return wide;
+    };
+    const RowMatrixXf one = run(1);
+    const auto out = one.middleCols(blocks_beside * kOutput, kOutput);
+    EXPECT_LT((out.cast<double>() - y).cwiseAbs().maxCoeff(), 1e-3);
+    if (blocks_beside) {
+      EXPECT_EQ(one.leftCols(kOutput), before.leftCols(kOutput));
+      EXPECT_EQ(one.rightCols(kOutput), before.rightCols(kOutput));
+    }
+    for (int threads = 2; threads <= 4; ++threads) EXPECT_EQ(run(threads), one) << threads;
+  }
+}
+
 TEST(Parameters, InitialisationIsSeededAndScaledByFanIn) {
   ParameterLayout layout;
   const size_t w = layout.add("w", 400, 300, Init::kFanIn);
@@ -156,8 +218,8 @@ TEST(Adam, ThreadedUpdatesGiveTheSameBitsAsOneThreadAndFollowTheFormula) {
   std::normal_distribution<float> normal;
   std::vector<float> start(n), g1(n), g2(n);
   for (size_t i = 0; i < n; ++i) start[i] = normal(rng), g1[i] = normal(rng), g2[i] = normal(rng);
-  const AdamConfig config{.learning_rate_start = 1e-2f, .learning_rate_end = 1e-3f,
-                          .decay_steps = 10};
+  const AdamConfig config{
+      .learning_rate_start = 1e-2f, .learning_rate_end = 1e-3f, .decay_steps = 10};
   std::vector<std::vector<float>> results;
   const int saved = omp_get_max_threads();
   for (const int threads : {1, 3}) {

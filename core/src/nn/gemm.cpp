@@ -167,24 +167,28 @@ constexpr Eigen::Index kProductBlockRows = 256;
 // kernels (oneDNN's avx2 ones) so do the rows' last bits. Instead the rows are cut into blocks of
 // kProductBlockRows, each block a one-thread product, and the blocks shared among the threads: a
 // row's bits depend only on its block, never on the thread count.
+// The row passes around each block run on the block's thread (gemm_bias with RowPass).
 void row_products(GemmEngine engine, const ConstMatrixRef& a, const ConstMatrixRef& b,
                   Transpose op_b, MatrixRef c, bool accumulate, const float* bias,
-                  Activation activation) {
+                  Activation activation, RowPass prologue = {}, RowPass epilogue = {}) {
   const Eigen::Index m = c.rows();
   const Eigen::Index blocks = (m + kProductBlockRows - 1) / kProductBlockRows;
   auto run_block = [&](int block) {
     const Eigen::Index first = block * kProductBlockRows;
     const Eigen::Index rows = std::min(kProductBlockRows, m - first);
+    prologue(first, rows);
     const ConstMatrixRef a_rows = a.middleRows(first, rows);
     MatrixRef c_rows = c.middleRows(first, rows);
 #ifdef FIGNET_WITH_ONEDNN
     if (engine == GemmEngine::kOneDnn && rows == kProductBlockRows &&
         detail::onednn_matmul_one_thread(a_rows, b, op_b, c_rows, accumulate, bias, activation)) {
+      epilogue(first, rows);
       return;
     }
 #endif
     gemm_one_thread(engine, a_rows, Transpose::kNo, b, op_b, c_rows, accumulate);
     if (bias) bias_activation(c_rows, bias, activation, c_rows);
+    epilogue(first, rows);
   };
   detail::parallel_for(static_cast<int>(blocks), threads_for_blocks(),
                        detail::Schedule::kContiguous, run_block);
@@ -247,18 +251,25 @@ void gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b, Tran
 
 void gemm_bias(const ConstMatrixRef& a, const ConstMatrixRef& b, Transpose op_b, const float* bias,
                Activation activation, MatrixRef c) {
+  gemm_bias(a, b, op_b, bias, activation, c, {}, {});
+}
+
+void gemm_bias(const ConstMatrixRef& a, const ConstMatrixRef& b, Transpose op_b, const float* bias,
+               Activation activation, MatrixRef c, RowPass prologue, RowPass epilogue) {
   const Eigen::Index k = a.cols();
   eigen_assert(c.rows() == a.rows());
   eigen_assert(c.cols() == (op_b == Transpose::kNo ? b.cols() : b.rows()));
   eigen_assert(k == (op_b == Transpose::kNo ? b.rows() : b.cols()));
   if (c.rows() == 0 || c.cols() == 0) return;
   if (k == 0) {
+    prologue(0, c.rows());
     c.setZero();
     bias_activation(c, bias, activation, c);
+    epilogue(0, c.rows());
     return;
   }
   row_products(current_engine().load(std::memory_order_relaxed), a, b, op_b, c, false, bias,
-               activation);
+               activation, prologue, epilogue);
 }
 
 // The elementwise passes walk each row once while it is in L1, with plain loops over contiguous

@@ -59,46 +59,85 @@ void relu_backward(MatrixRef d, const ConstMatrixRef& activation, float* db) {
   }
 }
 
+// The first layer's bias and ReLU on a block of rows, as the second layer's product reads them.
+struct FirstActivation {
+  MatrixView first, hidden1;
+  const float* bias;
+
+  static void run(const void* context, Eigen::Index first_row, Eigen::Index rows) {
+    const auto& pass = *static_cast<const FirstActivation*>(context);
+    MatrixView first = pass.first, hidden1 = pass.hidden1;
+    bias_activation(first.middleRows(first_row, rows), pass.bias, Activation::kRelu,
+                    hidden1.middleRows(first_row, rows));
+  }
+};
+
+// LayerNorm over each row of a block of the output layer's product, as it leaves the product:
+// x̂ = (y − μ)/sqrt(σ² + ε), out = scale·x̂ + offset; x̂ and 1/σ are kept for backward.
+struct LayerNormRows {
+  float* out;
+  Eigen::Index out_stride;
+  float* normalized;  // rows of `width`
+  float* inv_std;
+  int width;
+  const float* scale;
+  const float* offset;
+
+  static void run(const void* context, Eigen::Index first_row, Eigen::Index rows) {
+    const auto& pass = *static_cast<const LayerNormRows*>(context);
+    const int width = pass.width;
+    const float inv_width = 1.0f / static_cast<float>(width);
+    const float* scale = pass.scale;
+    const float* offset = pass.offset;
+    for (Eigen::Index r = first_row; r < first_row + rows; ++r) {
+      float* y = pass.out + r * pass.out_stride;
+      float* x_hat = pass.normalized + r * width;
+      float sum = 0.0f;
+#pragma omp simd reduction(+ : sum)
+      for (int c = 0; c < width; ++c) sum += y[c];
+      const float mean = sum * inv_width;
+      float squares = 0.0f;
+#pragma omp simd reduction(+ : squares)
+      for (int c = 0; c < width; ++c) {
+        x_hat[c] = y[c] - mean;
+        squares += x_hat[c] * x_hat[c];
+      }
+      const float inv = 1.0f / std::sqrt(squares * inv_width + Mlp::kLayerNormEpsilon);
+      pass.inv_std[r] = inv;
+      for (int c = 0; c < width; ++c) {
+        x_hat[c] *= inv;
+        y[c] = scale[c] * x_hat[c] + offset[c];
+      }
+    }
+  }
+};
+
 }  // namespace
 
 void Mlp::forward(const float* params, MatrixView first, MlpCache& cache, MatrixRef out) const {
   const Eigen::Index n = first.rows();
-  // Hidden layers: ReLU(x·W + b); the second's bias and ReLU run inside its product.
+  // Hidden layers: ReLU(x·W + b). The first's bias and ReLU run on each block of rows just before
+  // the second's product reads it; the second's inside its product.
   MatrixView h1 = cache.hidden1.view(n, hidden_);
-  bias_activation(first, params + b0_, Activation::kRelu, h1);
   MatrixView h2 = cache.hidden2.view(n, hidden_);
+  const FirstActivation first_activation{first, h1, params + b0_};
   gemm_bias(h1, tensor(params, w1_, hidden_, hidden_), Transpose::kNo, params + b1_,
-            Activation::kRelu, h2);
-  // Output layer: y = x·W2 + b2.
-  gemm_bias(h2, tensor(params, w2_, hidden_, output_), Transpose::kNo, params + b2_,
-            Activation::kNone, out);
-  if (!layer_norm_) return;
-  // LayerNorm over each row: x̂ = (y − μ)/sqrt(σ² + ε), out = scale·x̂ + offset.
-  MatrixView normalized = cache.normalized.view(n, output_);
-  MatrixView inv_std = cache.inv_std.view(n, 1);
-  const float* scale = params + scale_;
-  const float* offset = params + offset_;
-  const float inv_width = 1.0f / static_cast<float>(output_);
-  for (Eigen::Index r = 0; r < n; ++r) {
-    float* y = out.row(r).data();
-    float* x_hat = normalized.row(r).data();
-    float sum = 0.0f;
-#pragma omp simd reduction(+ : sum)
-    for (int c = 0; c < output_; ++c) sum += y[c];
-    const float mean = sum * inv_width;
-    float squares = 0.0f;
-#pragma omp simd reduction(+ : squares)
-    for (int c = 0; c < output_; ++c) {
-      x_hat[c] = y[c] - mean;
-      squares += x_hat[c] * x_hat[c];
-    }
-    const float inv = 1.0f / std::sqrt(squares * inv_width + kLayerNormEpsilon);
-    inv_std(r, 0) = inv;
-    for (int c = 0; c < output_; ++c) {
-      x_hat[c] *= inv;
-      y[c] = scale[c] * x_hat[c] + offset[c];
-    }
+            Activation::kRelu, h2, {&FirstActivation::run, &first_activation}, {});
+  // Output layer: y = x·W2 + b2, then LayerNorm on each block of rows as it leaves the product.
+  LayerNormRows layer_norm_rows{};
+  RowPass layer_norm;
+  if (layer_norm_) {
+    layer_norm_rows = {out.data(),
+                       out.outerStride(),
+                       cache.normalized.view(n, output_).data(),
+                       cache.inv_std.view(n, 1).data(),
+                       output_,
+                       params + scale_,
+                       params + offset_};
+    layer_norm = {&LayerNormRows::run, &layer_norm_rows};
   }
+  gemm_bias(h2, tensor(params, w2_, hidden_, output_), Transpose::kNo, params + b2_,
+            Activation::kNone, out, {}, layer_norm);
 }
 
 void Mlp::backward(const float* params, float* grads, const ConstMatrixRef& d_out,

@@ -35,6 +35,23 @@ void gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b, Tran
 // Eigen, as one pass over c after it (bias_activation). Same threading and bits as gemm().
 void gemm_bias(const ConstMatrixRef& a, const ConstMatrixRef& b, Transpose op_b, const float* bias,
                Activation activation, MatrixRef c);
+
+// A row-wise pass fused into a product's blocks of rows: run(context, first, rows) with the
+// block's first row and row count, on the thread that computes the block, while its rows are in
+// cache. A prologue runs before the block's product (it may write the rows of a the block reads),
+// an epilogue after it (and after the bias and activation). Rows are independent, so a pass
+// gives the same bits as a loop over all rows before or after the product, for any thread count.
+struct RowPass {
+  void (*run)(const void* context, Eigen::Index first, Eigen::Index rows) = nullptr;
+  const void* context = nullptr;
+  void operator()(Eigen::Index first, Eigen::Index rows) const {
+    if (run) run(context, first, rows);
+  }
+};
+
+// gemm_bias with a prologue and an epilogue over each block of rows (either may be empty).
+void gemm_bias(const ConstMatrixRef& a, const ConstMatrixRef& b, Transpose op_b, const float* bias,
+               Activation activation, MatrixRef c, RowPass prologue, RowPass epilogue);
 // out = act(x + bias), row by row; x may be out.
 void bias_activation(const ConstMatrixRef& x, const float* bias, Activation activation,
                      MatrixRef out);
