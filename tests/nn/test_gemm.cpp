@@ -233,17 +233,17 @@ TEST_P(Gemm, RowPassesRunOnEveryRowOnceBeforeAndAfterItsProduct) {
     const RowMatrixXf* source;
     RowMatrixXf* a;
     RowMatrixXf* c;
-    std::vector<int>* before;  // per row: 1 once the prologue ran, 2 once the epilogue did
+    std::vector<int>* visits;  // per row: +1 for each prologue, +10 for each epilogue
   };
   auto prologue = [](const void* context, Eigen::Index first, Eigen::Index rows) {
     const auto& p = *static_cast<const Passes*>(context);
     p.a->middleRows(first, rows) = 2.0f * p.source->middleRows(first, rows);
-    for (Eigen::Index r = first; r < first + rows; ++r) (*p.before)[r] += 1;
+    for (Eigen::Index r = first; r < first + rows; ++r) (*p.visits)[r] += 1;
   };
   auto epilogue = [](const void* context, Eigen::Index first, Eigen::Index rows) {
     const auto& p = *static_cast<const Passes*>(context);
     p.c->middleRows(first, rows) = p.c->middleRows(first, rows).cwiseAbs2();
-    for (Eigen::Index r = first; r < first + rows; ++r) (*p.before)[r] += 10;
+    for (Eigen::Index r = first; r < first + rows; ++r) (*p.visits)[r] += 10;
   };
   for (int threads = 1; threads <= 4; ++threads) {
     Eigen::setNbThreads(threads);

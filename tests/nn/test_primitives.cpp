@@ -112,9 +112,9 @@ TEST(Mlp, LayerNormOutputHasZeroMeanUnitVariancePerRow) {
 
 // The forward pass over rows of several product blocks (the full ones run through oneDNN's
 // primitive, the last partial one through sgemm; the first layer's ReLU and LayerNorm run on each
-// block as the products reach it), into a column block of a wider matrix: against the MLP in
-// double precision from its parameters, the neighbouring columns untouched, and the same bits
-// for any thread count.
+// block as the products reach it), into a matrix of its own and into a column block of a wider
+// one: against the MLP in double precision from its parameters, the neighbouring columns
+// untouched, and the same bits for any thread count.
 TEST(Mlp, ForwardOverManyBlocksMatchesADoublePrecisionMlpForAnyThreadCount) {
   using MatrixXdRow = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   constexpr int kRows = 700, kInput = 12, kHidden = 64, kOutput = 64;
