@@ -60,7 +60,8 @@ void run_generate(GenerateArgs args) {
   bar.finish(total);
   write_trajectories(
       args.out, trajectories,
-      {args.options.scene.preset, FIGNET_VERSION, args.options.seed, args.options.scene.stacks});
+      {args.options.scene.preset, FIGNET_VERSION, args.options.seed, args.options.scene.stacks,
+       args.options.scene.min_stack_levels, args.options.scene.max_stack_levels});
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   fmt::print("wrote {} trajectories ({} frames each) to {} in {:.1f} s\n", trajectories.size(),
@@ -93,12 +94,23 @@ void add_generate_command(CLI::App& app) {
   cmd->add_option("--max-objects", args->options.scene.max_objects, "Most tossed objects per scene")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
-  cmd->add_option(
-         "--stacks", args->options.scene.stacks,
-         "Stacks of 1-3 cubes and upright cylinders standing still on the floor of each "
-         "movi-a or movi-b scene, placed before the tossed objects (--min-objects may then "
-         "be 0); 0: the preset's own scenes")
-      ->check(CLI::Range(0, 20))
+  CLI::Option* stacks =
+      cmd->add_option(
+             "--stacks", args->options.scene.stacks,
+             "Stacks of cubes and upright cylinders standing still on the floor of each "
+             "movi-a or movi-b scene, placed before the tossed objects (--min-objects may then "
+             "be 0); 0: the preset's own scenes")
+          ->check(CLI::Range(0, 20))
+          ->capture_default_str();
+  cmd->add_option("--min-stack-levels", args->options.scene.min_stack_levels,
+                  "Fewest levels per stack (with --stacks)")
+      ->needs(stacks)
+      ->check(CLI::Range(1, bullet::kMaxStackLevels))
+      ->capture_default_str();
+  cmd->add_option("--max-stack-levels", args->options.scene.max_stack_levels,
+                  "Most levels per stack (with --stacks); the levels are uniform in the range")
+      ->needs(stacks)
+      ->check(CLI::Range(1, bullet::kMaxStackLevels))
       ->capture_default_str();
   cmd->add_option("--assets", args->options.scene.assets,
                   "Folder of mesh files (OBJ, STL, PLY, glTF, OFF): extra objects for movi-b, the "

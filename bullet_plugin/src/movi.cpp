@@ -101,7 +101,7 @@ bool clear_of(const BoundingSpheres& placed, const Vec3& center, double radius) 
   return true;
 }
 
-// options.stacks stacks of 1–3 cubes and upright cylinders at rest on spec's floor. Their own
+// options.stacks stacks of cubes and upright cylinders at rest on spec's floor. Their own
 // generator keeps the tossed objects' draws as MOVi's; `placed` receives their bounding spheres
 // so the tossed objects spawn clear of them.
 void add_stacks(const MoviOptions& options, bool movi_a, std::uint64_t seed, SceneSpec& spec,
@@ -112,7 +112,10 @@ void add_stacks(const MoviOptions& options, bool movi_a, std::uint64_t seed, Sce
   const double margin = spec.collision_margin;
   for (int s = 0; s < options.stacks; ++s) {
     // Build the stack around the vertical axis through the origin, then move it to a free spot.
-    const int levels = 1 + std::min(2, static_cast<int>(unit(rng) * 3));
+    // With the default 1–3 levels this is the draw the first stacks data was made with.
+    const int span = options.max_stack_levels - options.min_stack_levels;
+    const int levels =
+        options.min_stack_levels + std::min(span, static_cast<int>(unit(rng) * (span + 1)));
     std::vector<BodySpec> stack;
     std::vector<double> half_widths;  // cube and cylinder alike: half-width = half-height = scale
     double top = spec.floor->height;
@@ -194,6 +197,12 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
   }
   if (options.stacks < 0) {
     throw ConfigError(fmt::format("stacks = {} (must be >= 0)", options.stacks));
+  }
+  if (options.min_stack_levels < 1 || options.max_stack_levels < options.min_stack_levels ||
+      options.max_stack_levels > kMaxStackLevels) {
+    throw ConfigError(fmt::format("stack levels {}..{}: need 1 <= min <= max <= {}",
+                                  options.min_stack_levels, options.max_stack_levels,
+                                  kMaxStackLevels));
   }
   if (options.stacks > 0 && movi_c) {
     throw ConfigError("stacks need cubes and cylinders: preset movi-a or movi-b, not movi-c");

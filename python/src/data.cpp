@@ -267,10 +267,13 @@ shape (frames, objects, 3) and quaternions (frames, objects, 4) as (w, x, y, z).
       "generate",
       [](const std::string& preset, int count, std::uint64_t seed,
          std::optional<std::filesystem::path> path, int frames, int threads,
-         std::optional<std::filesystem::path> assets, int stacks) {
+         std::optional<std::filesystem::path> assets, int stacks, int min_stack_levels,
+         int max_stack_levels) {
         bullet::GenerateOptions options;
         options.scene.preset = preset;
         options.scene.stacks = stacks;
+        options.scene.min_stack_levels = min_stack_levels;
+        options.scene.max_stack_levels = max_stack_levels;
         options.scene.frames = frames;
         if (assets) options.scene.assets = *assets;
         options.count = count;
@@ -281,18 +284,22 @@ shape (frames, objects, 3) and quaternions (frames, objects, 4) as (w, x, y, z).
           py::gil_scoped_release release;
           trajectories = bullet::generate_dataset(options);
           if (path) {
-            write_trajectories(*path, trajectories, {preset, FIGNET_VERSION, seed, stacks});
+            write_trajectories(
+                *path, trajectories,
+                {preset, FIGNET_VERSION, seed, stacks, min_stack_levels, max_stack_levels});
           }
         }
         return trajectories;
       },
       py::arg("preset") = "movi-a", py::arg("count") = 1, py::arg("seed") = 1,
       py::arg("path") = py::none(), py::arg("frames") = 0, py::arg("threads") = 0,
-      py::arg("assets") = py::none(), py::arg("stacks") = 0,
+      py::arg("assets") = py::none(), py::arg("stacks") = 0, py::arg("min_stack_levels") = 1,
+      py::arg("max_stack_levels") = 3,
       R"(Simulates `count` scenes of a preset ("movi-a", "movi-b", "movi-c", "pushing") in native
 Bullet, as `fignet generate` does: the same seed gives the same trajectories. Writes them to
 `path` when given; returns them. frames 0: the preset's own; threads 0: every core; stacks:
-stacks at rest added to each movi-a or movi-b scene, as `fignet generate --stacks`.)");
+stacks at rest added to each movi-a or movi-b scene, as `fignet generate --stacks`, each
+min_stack_levels to max_stack_levels high.)");
 }
 
 }  // namespace fignet::python

@@ -1,6 +1,7 @@
 #include "fignet/io/trajectory_file.h"
 
 #include <functional>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -188,6 +189,8 @@ void write_trajectories(const std::filesystem::path& path, std::span<const Traje
     hdf5::write_attribute(root, "generator_version", info.generator_version);
     hdf5::write_attribute(root, "seed", static_cast<long long>(info.seed));
     hdf5::write_attribute(root, "stacks", static_cast<long long>(info.stacks));
+    hdf5::write_attribute(root, "min_stack_levels", static_cast<long long>(info.min_stack_levels));
+    hdf5::write_attribute(root, "max_stack_levels", static_cast<long long>(info.max_stack_levels));
     hdf5::write_attribute(root, "num_trajectories", static_cast<long long>(trajectories.size()));
     H5::Group group = hdf5::create_group(file, "trajectories");
     for (size_t i = 0; i < trajectories.size(); ++i) {
@@ -222,6 +225,12 @@ long long read_file(const std::filesystem::path& path, DatasetInfo* info, long l
       // Files written before stacks existed hold the preset's scenes.
       info->stacks =
           root.attrExists("stacks") ? static_cast<int>(hdf5::read_integer(root, "stacks")) : 0;
+      // Files written before the levels were an option hold stacks of 1–3.
+      for (auto [name, field, absent] :
+           {std::tuple("min_stack_levels", &info->min_stack_levels, 1),
+            std::tuple("max_stack_levels", &info->max_stack_levels, 3)}) {
+        *field = root.attrExists(name) ? static_cast<int>(hdf5::read_integer(root, name)) : absent;
+      }
     }
     const long long count = hdf5::read_integer(root, "num_trajectories");
     const H5::Group group = file.openGroup("trajectories");

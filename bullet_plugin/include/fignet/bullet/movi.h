@@ -11,15 +11,20 @@
 
 namespace fignet::bullet {
 
+inline constexpr int kMaxStackLevels = 10;
+
 struct MoviOptions {
   std::string preset = "movi-a";  // "movi-a", "movi-b", "movi-c" or "pushing"
   int min_objects = 3, max_objects = 10;
   int frames = 0;  // 0: the preset's own (movi-a 96, pushing 42)
-  // Stacks of 1–3 cubes and upright cylinders standing still on the floor when a movi-a or movi-b
+  // Stacks of cubes and upright cylinders standing still on the floor when a movi-a or movi-b
   // scene starts, this many per scene, placed before the tossed objects (which spawn clear of them
   // and may knock them over). MOVi throws every body, so its data holds few bodies resting on one
   // another and no stack; 0 keeps MOVi's scenes, bit for bit.
   int stacks = 0;
+  // Levels per stack, uniform in this range (at most kMaxStackLevels). 1–3 is what the stacks
+  // data of issue 14 used; taller stacks put more of the data's rest on other bodies.
+  int min_stack_levels = 1, max_stack_levels = 3;
   // A folder of mesh files: extra objects for movi-b, the only objects of movi-c.
   std::filesystem::path assets;
   // How asset meshes become bodies: repair, node budget, inertia mode (see mesh_import.h).
@@ -39,7 +44,8 @@ struct MoviOptions {
 // or messy (options.mesh_import says how they are repaired, simplified and weighed); non-convex
 // ones collide as HACD decompositions. options.stacks adds stacks at rest (a variant, not MOVi):
 // the stacks come first, from their own generator, each at a uniform spot in (−4,−4)–(4,4) clear
-// of the stacks before it (≤ 100 tries, else left out), each level a cube or an upright cylinder
+// of the stacks before it (≤ 100 tries, else left out), min_stack_levels–max_stack_levels levels
+// high (uniform), each level a cube or an upright cylinder
 // of the preset's scales and materials, turned by a uniform angle about the vertical, shifted by
 // at most a tenth of the smaller of its and its support's half-widths, and resting on its support
 // at the collision margin. Throws ConfigError for a bad option,

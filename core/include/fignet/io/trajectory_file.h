@@ -21,6 +21,7 @@ struct DatasetInfo {
   std::string generator_version;  // the generating program's version
   std::uint64_t seed = 0;         // the generator's base seed
   int stacks = 0;                 // stacks at rest per scene (generate --stacks); 0: the preset's
+  int min_stack_levels = 1, max_stack_levels = 3;  // levels per stack (generate --*-stack-levels)
 };
 
 // Writes to a temporary file beside `path`, then renames it into place. Throws FileError.
