@@ -1,7 +1,6 @@
 #include "fignet/io/trajectory_file.h"
 
 #include <functional>
-#include <tuple>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -226,11 +225,12 @@ long long read_file(const std::filesystem::path& path, DatasetInfo* info, long l
       info->stacks =
           root.attrExists("stacks") ? static_cast<int>(hdf5::read_integer(root, "stacks")) : 0;
       // Files written before the levels were an option hold stacks of 1–3.
-      for (auto [name, field, absent] :
-           {std::tuple("min_stack_levels", &info->min_stack_levels, 1),
-            std::tuple("max_stack_levels", &info->max_stack_levels, 3)}) {
-        *field = root.attrExists(name) ? static_cast<int>(hdf5::read_integer(root, name)) : absent;
-      }
+      info->min_stack_levels = root.attrExists("min_stack_levels")
+                                   ? static_cast<int>(hdf5::read_integer(root, "min_stack_levels"))
+                                   : 1;
+      info->max_stack_levels = root.attrExists("max_stack_levels")
+                                   ? static_cast<int>(hdf5::read_integer(root, "max_stack_levels"))
+                                   : 3;
     }
     const long long count = hdf5::read_integer(root, "num_trajectories");
     const H5::Group group = file.openGroup("trajectories");
