@@ -58,10 +58,7 @@ void run_generate(GenerateArgs args) {
   }
   const std::vector<Trajectory> trajectories = future.get();
   bar.finish(total);
-  write_trajectories(
-      args.out, trajectories,
-      {args.options.scene.preset, FIGNET_VERSION, args.options.seed, args.options.scene.stacks,
-       args.options.scene.min_stack_levels, args.options.scene.max_stack_levels});
+  write_trajectories(args.out, trajectories, bullet::dataset_info(args.options, FIGNET_VERSION));
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   fmt::print("wrote {} trajectories ({} frames each) to {} in {:.1f} s\n", trajectories.size(),

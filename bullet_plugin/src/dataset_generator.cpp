@@ -5,6 +5,7 @@
 #include <exception>
 #include <mutex>
 #include <thread>
+#include <utility>
 
 #include "fignet/error.h"
 
@@ -55,6 +56,15 @@ std::vector<Trajectory> generate_dataset(const GenerateOptions& options, std::at
   for (auto& thread : pool) thread.join();
   if (failure) std::rethrow_exception(failure);
   return result;
+}
+
+DatasetInfo dataset_info(const GenerateOptions& options, std::string generator_version) {
+  return {.preset = options.scene.preset,
+          .generator_version = std::move(generator_version),
+          .seed = options.seed,
+          .stacks = options.scene.stacks,
+          .min_stack_levels = options.scene.min_stack_levels,
+          .max_stack_levels = options.scene.max_stack_levels};
 }
 
 }  // namespace fignet::bullet

@@ -284,9 +284,7 @@ shape (frames, objects, 3) and quaternions (frames, objects, 4) as (w, x, y, z).
           py::gil_scoped_release release;
           trajectories = bullet::generate_dataset(options);
           if (path) {
-            write_trajectories(
-                *path, trajectories,
-                {preset, FIGNET_VERSION, seed, stacks, min_stack_levels, max_stack_levels});
+            write_trajectories(*path, trajectories, bullet::dataset_info(options, FIGNET_VERSION));
           }
         }
         return trajectories;

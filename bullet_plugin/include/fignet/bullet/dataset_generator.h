@@ -5,10 +5,12 @@
 
 #include <atomic>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "fignet/bullet/bullet_simulation.h"
 #include "fignet/bullet/movi.h"
+#include "fignet/io/trajectory_file.h"
 
 namespace fignet::bullet {
 
@@ -28,5 +30,9 @@ std::uint64_t trajectory_seed(std::uint64_t seed, std::uint64_t index);
 // Throws ConfigError for invalid options.
 std::vector<Trajectory> generate_dataset(const GenerateOptions& options,
                                          std::atomic<int>* done = nullptr);
+
+// What a file of this dataset records about how it was made (its attributes), so that every
+// writer of generated data records the same fields. `generator_version`: the writing program's.
+DatasetInfo dataset_info(const GenerateOptions& options, std::string generator_version);
 
 }  // namespace fignet::bullet
