@@ -305,13 +305,7 @@ TEST(Generator, DatasetInfoRecordsEveryOptionThatShapesTheScenes) {
   options.scene.stacks = 2;
   options.scene.min_stack_levels = 4;
   options.scene.max_stack_levels = 6;
-  const DatasetInfo info = dataset_info(options, "9.8.7");
-  EXPECT_EQ(info.preset, "movi-b");
-  EXPECT_EQ(info.generator_version, "9.8.7");
-  EXPECT_EQ(info.seed, 19u);
-  EXPECT_EQ(info.stacks, 2);
-  EXPECT_EQ(info.min_stack_levels, 4);
-  EXPECT_EQ(info.max_stack_levels, 6);
+  EXPECT_EQ(dataset_info(options, "9.8.7"), (DatasetInfo{"movi-b", "9.8.7", 19, 2, 4, 6}));
 }
 
 TEST(Generator, BadOptionsAreConfigErrors) {

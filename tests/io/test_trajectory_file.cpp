@@ -56,15 +56,11 @@ class TrajectoryFile : public testing::TempFolderTest {
 
 TEST_F(TrajectoryFile, WriteThenReadRoundTripsExactly) {
   const auto data = make_data(3);
-  write_trajectories(dir_ / "set.h5", data, {"movi-a", "0.1.0", 7, 2, 3, 5});
+  const DatasetInfo written{"movi-a", "0.1.0", 7, 2, 3, 5};
+  write_trajectories(dir_ / "set.h5", data, written);
   DatasetInfo info;
   const auto read = read_trajectories(dir_ / "set.h5", &info);
-  EXPECT_EQ(info.preset, "movi-a");
-  EXPECT_EQ(info.generator_version, "0.1.0");
-  EXPECT_EQ(info.seed, 7u);
-  EXPECT_EQ(info.stacks, 2);
-  EXPECT_EQ(info.min_stack_levels, 3);
-  EXPECT_EQ(info.max_stack_levels, 5);
+  EXPECT_EQ(info, written);
   ASSERT_EQ(read.size(), 3u);
   for (size_t i = 0; i < 3; ++i) {
     EXPECT_EQ(read[i].seed, data[i].seed);
