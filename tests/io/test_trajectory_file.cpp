@@ -83,6 +83,15 @@ TEST_F(TrajectoryFile, WriteThenReadRoundTripsExactly) {
       EXPECT_EQ(a.linear_velocities, b.linear_velocities);
     }
   }
+  // A file from before stacks and their levels were options reads as the preset's scenes, 1-3.
+  {
+    H5::H5File file(std::string(dir_ / "set.h5"), H5F_ACC_RDWR);
+    H5::Group root = file.openGroup("/");
+    for (const char* name : {"stacks", "min_stack_levels", "max_stack_levels"})
+      root.removeAttr(name);
+  }
+  read_trajectories(dir_ / "set.h5", &info);
+  EXPECT_EQ(info, (DatasetInfo{"movi-a", "0.1.0", 7, 0, 1, 3}));
   // Shards read back in order.
   write_trajectories(dir_ / "shard1.h5", make_data(2), {"movi-a", "0.1.0", 8});
   EXPECT_EQ(read_trajectories({dir_ / "set.h5", dir_ / "shard1.h5"}).size(), 5u);

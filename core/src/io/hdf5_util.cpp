@@ -99,6 +99,10 @@ long long read_integer(const H5::H5Object& object, const std::string& name) {
   return value;
 }
 
+long long read_integer_or(const H5::H5Object& object, const std::string& name, long long absent) {
+  return object.attrExists(name) ? read_integer(object, name) : absent;
+}
+
 std::string read_string(const H5::H5Object& object, const std::string& name) {
   const H5::Attribute attribute = object.openAttribute(name);
   std::string value;

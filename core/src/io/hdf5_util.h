@@ -28,6 +28,9 @@ void write_attribute(H5::H5Object& object, const std::string& name, const std::s
 double read_double(const H5::H5Object& object, const std::string& name);
 long long read_integer(const H5::H5Object& object, const std::string& name);
 std::string read_string(const H5::H5Object& object, const std::string& name);
+// An attribute added to a format after its first files: `absent` (what those files were made
+// with) when the file has none.
+long long read_integer_or(const H5::H5Object& object, const std::string& name, long long absent);
 
 // Row-major datasets of floats or doubles with the given shape.
 void write_floats(H5::Group& group, const std::string& path, const float* data,

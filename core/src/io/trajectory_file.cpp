@@ -222,15 +222,10 @@ long long read_file(const std::filesystem::path& path, DatasetInfo* info, long l
       info->generator_version = hdf5::read_string(root, "generator_version");
       info->seed = static_cast<std::uint64_t>(hdf5::read_integer(root, "seed"));
       // Files written before stacks existed hold the preset's scenes.
-      info->stacks =
-          root.attrExists("stacks") ? static_cast<int>(hdf5::read_integer(root, "stacks")) : 0;
+      info->stacks = static_cast<int>(hdf5::read_integer_or(root, "stacks", 0));
       // Files written before the levels were an option hold stacks of 1–3.
-      info->min_stack_levels = root.attrExists("min_stack_levels")
-                                   ? static_cast<int>(hdf5::read_integer(root, "min_stack_levels"))
-                                   : 1;
-      info->max_stack_levels = root.attrExists("max_stack_levels")
-                                   ? static_cast<int>(hdf5::read_integer(root, "max_stack_levels"))
-                                   : 3;
+      info->min_stack_levels = static_cast<int>(hdf5::read_integer_or(root, "min_stack_levels", 1));
+      info->max_stack_levels = static_cast<int>(hdf5::read_integer_or(root, "max_stack_levels", 3));
     }
     const long long count = hdf5::read_integer(root, "num_trajectories");
     const H5::Group group = file.openGroup("trajectories");
