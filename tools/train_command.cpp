@@ -218,6 +218,8 @@ void run_train(const TrainArgs& args) {
   if (args.resume) trainer.restore(state);
   if (auto backend = make_backend(args.device, trainer.network())) {
     trainer.set_backend(std::move(backend));
+    // A GPU leaves the cores free while it runs the passes: the next batch is built meanwhile.
+    trainer.set_build_ahead(true);
   }
   if (root) fmt::print("network passes on: {}\n", trainer.backend().name());
   if (!args.resume && config.trainer.statistics_warmup > 0) {
@@ -300,10 +302,15 @@ void run_train(const TrainArgs& args) {
   const double steps_run =
       std::max<double>(1.0, static_cast<double>(trainer.steps_done() - first_step));
   fmt::print(
-      "per step ({} scenes): {:.1f} ms building graphs, {:.1f} ms input statistics, {:.1f} ms "
+      "per step ({} scenes): {:.1f} ms building graphs{}, {:.1f} ms input statistics, {:.1f} ms "
       "network ({}), {:.1f} ms Adam\n",
-      config.trainer.batch_size, 1e3 * times.build / steps_run, 1e3 * times.statistics / steps_run,
-      1e3 * times.network / steps_run, trainer.backend().name(), 1e3 * times.optimizer / steps_run);
+      config.trainer.batch_size, 1e3 * times.build / steps_run,
+      trainer.builds_ahead()
+          ? fmt::format(" ({:.1f} ms of it waited for, the rest beside the step before)",
+                        1e3 * times.build_waited / steps_run)
+          : "",
+      1e3 * times.statistics / steps_run, 1e3 * times.network / steps_run, trainer.backend().name(),
+      1e3 * times.optimizer / steps_run);
   if (const std::string profile = trainer.backend().profile(); !profile.empty()) {
     fmt::print("{}: {}\n", trainer.backend().name(), profile);
   }

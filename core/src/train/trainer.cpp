@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "fignet/error.h"
+#include "parallel/background_task.h"
 #include "parallel/parallel_for.h"
 
 namespace fignet {
@@ -43,8 +44,7 @@ Trainer::Trainer(const ModelConfig& config, const TrainerConfig& trainer_config,
       network_(config),
       normalizers_(network_.make_normalizers()),
       collective_(collective ? collective : &single_process()),
-      backend_(make_cpu_backend(network_)),
-      builders_(1, GraphBuilder(config.graph)) {
+      backend_(make_cpu_backend(network_)) {
   if (trainer_config.batch_size < 1) {
     throw ConfigError(
         fmt::format("trainer: batch_size = {} (must be >= 1)", trainer_config.batch_size));
@@ -95,46 +95,40 @@ std::mt19937_64 Trainer::step_generator(std::int64_t step) const {
   return std::mt19937_64(sequence);
 }
 
-void Trainer::prepare_batch(const std::vector<SampleRef>& batch, std::mt19937_64& noise,
-                            bool accumulate) {
+Trainer::~Trainer() = default;
+
+void Trainer::build_current(const std::vector<SampleRef>& samples, std::mt19937_64 noise) {
+  build_batch(samples, noise, omp_get_max_threads(), current());
+  times_.build += current().build_seconds;
+}
+
+void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64 noise, int threads,
+                          PreparedBatch& batch) const {
   const auto start = std::chrono::steady_clock::now();
-  for (const SampleRef& sample : batch) {
+  for (const SampleRef& sample : samples) {
     if (sample.trajectory < 0 || sample.trajectory >= static_cast<int>(data_.size())) {
       throw ConfigError(fmt::format("trainer: sample of trajectory {} (this process has {})",
                                     sample.trajectory, data_.size()));
     }
   }
-  build_batch_graph(batch, noise);
-  gather_targets(graph_, scene_targets_, targets_, in_loss_);
-  if (weighs_rest()) {
-    gather_loss_weights(graph_, scene_resting_, trainer_config_.rest_loss_weight, loss_weights_);
-  }
-  times_.build += seconds_since(start);
-  if (accumulate) {
-    const auto statistics_start = std::chrono::steady_clock::now();
-    accumulate_statistics();
-    times_.statistics += seconds_since(statistics_start);
-  }
-}
-
-void Trainer::build_batch_graph(const std::vector<SampleRef>& batch, std::mt19937_64& noise) {
   const int h = config_.graph.history;
-  const int scenes = static_cast<int>(batch.size());
-  scenes_.resize(scenes);
-  scene_targets_.resize(scenes);
-  if (weighs_rest()) scene_resting_.resize(scenes);
+  const int scenes = static_cast<int>(samples.size());
+  batch.scenes.resize(scenes);
+  batch.scene_targets.resize(scenes);
+  if (weighs_rest()) batch.scene_resting.resize(scenes);
   // One noise seed per scene, drawn in scene order: the noise does not depend on the threads.
-  scene_seeds_.resize(scenes);
-  for (std::uint64_t& seed : scene_seeds_) seed = noise();
+  batch.scene_seeds.resize(scenes);
+  for (std::uint64_t& seed : batch.scene_seeds) seed = noise();
   auto make_samples = [&](int begin, int end) {
     for (int b = begin; b < end; ++b) {
-      const Trajectory& trajectory = data_[batch[b].trajectory];
-      std::mt19937_64 rng(scene_seeds_[b]);
+      const Trajectory& trajectory = data_[samples[b].trajectory];
+      const std::uint64_t scene_seed = batch.scene_seeds[b];
+      std::mt19937_64 rng(scene_seed);
       // Its own generator: runs without still bodies in the air draw the noise they always drew.
       double gap = 0.0;
       if (trainer_config_.still_air_fraction > 0.0f && can_hold_still_in_air(trajectory)) {
-        std::seed_seq still_seeds{static_cast<std::uint32_t>(scene_seeds_[b]),
-                                  static_cast<std::uint32_t>(scene_seeds_[b] >> 32),
+        std::seed_seq still_seeds{static_cast<std::uint32_t>(scene_seed),
+                                  static_cast<std::uint32_t>(scene_seed >> 32),
                                   std::uint32_t{0x57111}};
         std::mt19937_64 still(still_seeds);
         if (std::uniform_real_distribution<double>(0.0, 1.0)(still) <
@@ -144,47 +138,88 @@ void Trainer::build_batch_graph(const std::vector<SampleRef>& batch, std::mt1993
         }
       }
       if (gap > 0.0) {
-        make_still_sample_in_air(trajectory, batch[b].frame, h, gap, config_.noise_std,
-                                 config_.noise, config_.noise_correction, rng, scenes_[b],
-                                 scene_targets_[b]);
+        make_still_sample_in_air(trajectory, samples[b].frame, h, gap, config_.noise_std,
+                                 config_.noise, config_.noise_correction, rng, batch.scenes[b],
+                                 batch.scene_targets[b]);
       } else {
-        make_noisy_sample(trajectory, batch[b].frame, h, config_.noise_std, config_.noise,
-                          config_.noise_correction, rng, scenes_[b], scene_targets_[b]);
+        make_noisy_sample(trajectory, samples[b].frame, h, config_.noise_std, config_.noise,
+                          config_.noise_correction, rng, batch.scenes[b], batch.scene_targets[b]);
       }
       // Drawn after the noise: a run without the turn draws the same noise as before it existed.
       if (config_.random_yaw) {
         std::uniform_real_distribution<double> angle(0.0, 2.0 * std::numbers::pi);
-        turn_about_vertical(angle(rng), scenes_[b], scene_targets_[b]);
+        turn_about_vertical(angle(rng), batch.scenes[b], batch.scene_targets[b]);
       }
       if (weighs_rest()) {
         if (gap > 0.0) {
           // Every dynamic body is still, in the air.
-          scene_resting_[b].assign(trajectory.objects.size(), 1);
+          batch.scene_resting[b].assign(trajectory.objects.size(), 1);
         } else {
-          scene_resting_[b] =
-              resting_objects(trajectory, batch[b].frame, kRestSpeed * trajectory.time_step);
+          batch.scene_resting[b] =
+              resting_objects(trajectory, samples[b].frame, kRestSpeed * trajectory.time_step);
         }
       }
     }
   };
-  // Contiguous runs of scenes per thread; small batches stay on the calling thread.
-  constexpr int kMinScenesPerPart = 4;
-  const int parts = std::clamp(std::min(omp_get_max_threads(), scenes / kMinScenesPerPart), 1, 64);
+  // Contiguous runs of scenes, one run per thread (the graph is the same however they are cut:
+  // each part's nodes and edges are appended in scene order).
+  const int parts = std::clamp(std::min(threads, scenes), 1, 64);
+  while (static_cast<int>(batch.builders.size()) < parts)
+    batch.builders.emplace_back(config_.graph);
   if (parts == 1) {
     make_samples(0, scenes);
-    builders_[0].build(scenes_, graph_);
-    return;
+    batch.builders[0].build(batch.scenes, batch.graph);
+  } else {
+    if (static_cast<int>(batch.part_graphs.size()) < parts) batch.part_graphs.resize(parts);
+    const std::span<const Scene> all(batch.scenes);
+    // The first part is built straight into the batch graph, the others beside it.
+    detail::parallel_for(parts, parts, detail::Schedule::kContiguous, [&](int i) {
+      const int begin = scenes * i / parts, end = scenes * (i + 1) / parts;
+      make_samples(begin, end);
+      batch.builders[i].build(all.subspan(begin, end - begin),
+                              i == 0 ? batch.graph : batch.part_graphs[i]);
+    });
+    for (int i = 1; i < parts; ++i) append_graph(batch.part_graphs[i], batch.graph);
   }
-  while (static_cast<int>(builders_.size()) < parts) builders_.emplace_back(config_.graph);
-  if (static_cast<int>(part_graphs_.size()) < parts) part_graphs_.resize(parts);
-  const std::span<const Scene> all(scenes_);
-  // The first part is built straight into the batch graph, the others beside it.
-  detail::parallel_for(parts, parts, detail::Schedule::kContiguous, [&](int i) {
-    const int begin = scenes * i / parts, end = scenes * (i + 1) / parts;
-    make_samples(begin, end);
-    builders_[i].build(all.subspan(begin, end - begin), i == 0 ? graph_ : part_graphs_[i]);
+  gather_targets(batch.graph, batch.scene_targets, batch.targets, batch.in_loss);
+  if (weighs_rest()) {
+    gather_loss_weights(batch.graph, batch.scene_resting, trainer_config_.rest_loss_weight,
+                        batch.loss_weights);
+  }
+  batch.build_seconds = seconds_since(start);
+}
+
+void Trainer::set_build_ahead(bool on) {
+  if (on && !ahead_) ahead_ = std::make_unique<detail::BackgroundTask>();
+  if (!on && ahead_) {
+    // The batch in flight is dropped; what it threw too.
+    ahead_counter_ = -1;
+    ahead_.reset();
+  }
+}
+
+bool Trainer::take_batch_built_ahead(std::int64_t counter) {
+  if (ahead_counter_ < 0) return false;
+  const std::int64_t built_for = std::exchange(ahead_counter_, -1);
+  const auto start = std::chrono::steady_clock::now();
+  ahead_->wait();
+  // Built for another step number (a restore() or step_on() came in between): drawn anew.
+  if (built_for != counter) return false;
+  current_ = 1 - current_;
+  times_.build += current().build_seconds;
+  times_.build_waited += seconds_since(start);
+  return true;
+}
+
+void Trainer::start_building_ahead(std::int64_t counter) {
+  PreparedBatch& next = batches_[1 - current_];
+  // This thread's OpenMP setting: the background thread's own is the process default.
+  const int threads = omp_get_max_threads();
+  ahead_->start([this, &next, counter, threads] {
+    const std::uint64_t noise_seed = draw_batch(counter, next.samples);
+    build_batch(next.samples, std::mt19937_64(noise_seed), threads, next);
   });
-  for (int i = 1; i < parts; ++i) append_graph(part_graphs_[i], graph_);
+  ahead_counter_ = counter;
 }
 
 void Trainer::clip_gradient() {
@@ -199,15 +234,18 @@ void Trainer::clip_gradient() {
 }
 
 void Trainer::warm_up_statistics(int batches) {
-  const TrainerTimes before = times_;
+  const auto start = std::chrono::steady_clock::now();
+  const double steps_build = times_.build;
   for (int i = 0; i < batches; ++i) {
     // Counters from -1 down: apart from every training step's draws.
-    std::mt19937_64 noise(draw_batch(-1 - static_cast<std::int64_t>(i), batch_));
-    prepare_batch(batch_, noise, /*accumulate=*/true);
+    std::vector<SampleRef>& samples = current().samples;
+    const std::uint64_t noise_seed = draw_batch(-1 - static_cast<std::int64_t>(i), samples);
+    build_current(samples, std::mt19937_64(noise_seed));
+    accumulate_statistics();
   }
   // Its batches are no step's: the per-step phases stay the steps' own.
-  times_.warmup += (times_.build - before.build) + (times_.statistics - before.statistics);
-  times_.build = before.build, times_.statistics = before.statistics;
+  times_.build = steps_build;
+  times_.warmup += seconds_since(start);
 }
 
 void Trainer::set_backend(std::unique_ptr<NetworkBackend> backend) {
@@ -221,10 +259,11 @@ void Trainer::accumulate_statistics() {
   // This batch's statistics (MeshGraphNets style: every input block, and the dynamic nodes'
   // targets), counted from zero, ...
   batch_statistics_ = network_.make_normalizers();
-  network_.accumulate_input_statistics(graph_, batch_statistics_);
-  RowMatrixXf dynamic_targets(std::count(in_loss_.begin(), in_loss_.end(), 1), 3);
-  for (Eigen::Index i = 0, r = 0; i < targets_.rows(); ++i) {
-    if (in_loss_[i]) dynamic_targets.row(r++) = targets_.row(i);
+  const PreparedBatch& batch = current();
+  network_.accumulate_input_statistics(batch.graph, batch_statistics_);
+  RowMatrixXf dynamic_targets(std::count(batch.in_loss.begin(), batch.in_loss.end(), 1), 3);
+  for (Eigen::Index i = 0, r = 0; i < batch.targets.rows(); ++i) {
+    if (batch.in_loss[i]) dynamic_targets.row(r++) = batch.targets.row(i);
   }
   batch_statistics_.target.accumulate(dynamic_targets);
   // ... summed over processes in one flat buffer (count, sums, sums of squares per normaliser),
@@ -248,11 +287,12 @@ void Trainer::accumulate_statistics() {
 }
 
 double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
-  normalized_targets_.resize(targets_.rows(), 3);
-  normalizers_.target.normalize(targets_, normalized_targets_);
+  const PreparedBatch& batch = current();
+  normalized_targets_.resize(batch.targets.rows(), 3);
+  normalizers_.target.normalize(batch.targets, normalized_targets_);
   // The mean is over every process's dynamic nodes, counted before the network runs so that
   // each chunk of the batch can take its gradient as soon as its output exists.
-  double count = static_cast<double>(std::count(in_loss_.begin(), in_loss_.end(), 1));
+  double count = static_cast<double>(std::count(batch.in_loss.begin(), batch.in_loss.end(), 1));
   if (reduce) collective_->sum(std::span<double>(&count, 1));
   if (count == 0) return 0.0;
   // Squared error, or Huber's: quadratic within delta, linear beyond (scaled to match at 0).
@@ -272,8 +312,8 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
     if (d_output) d_output->setZero();
     for (Eigen::Index r = 0; r < output.rows(); ++r) {
       const Eigen::Index i = first + r;
-      if (!in_loss_[i]) continue;
-      const float weight = weighted ? loss_weights_[i] : 1.0f;
+      if (!batch.in_loss[i]) continue;
+      const float weight = weighted ? batch.loss_weights[i] : 1.0f;
       for (int c = 0; c < 3; ++c) {
         const double error = output(r, c) - normalized_targets_(i, c);
         squares += weight * loss_of(error);
@@ -286,12 +326,13 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
   if (with_gradient) {
     std::fill(grads_.begin(), grads_.end(), 0.0f);
     squares = backend_->forward_backward(
-        params_.data(), normalizers_, graph_, grads_.data(),
+        params_.data(), normalizers_, batch.graph, grads_.data(),
         [&](int first, const ConstMatrixRef& output, MatrixRef d_output) {
           return node_loss(first, output, &d_output);
         });
   } else {
-    squares = node_loss(0, backend_->forward(params_.data(), normalizers_, graph_, false), nullptr);
+    squares =
+        node_loss(0, backend_->forward(params_.data(), normalizers_, batch.graph, false), nullptr);
   }
   if (reduce) collective_->sum(std::span<double>(&squares, 1));
   if (with_gradient) {
@@ -311,13 +352,26 @@ std::uint64_t Trainer::draw_batch(std::int64_t counter, std::vector<SampleRef>& 
 }
 
 TrainStep Trainer::step() {
-  const std::uint64_t noise_seed = draw_batch(adam_.step(), batch_);
-  return step_on(batch_, noise_seed);
+  const std::int64_t counter = adam_.step();
+  if (!take_batch_built_ahead(counter)) {
+    std::vector<SampleRef>& samples = current().samples;
+    const std::uint64_t noise_seed = draw_batch(counter, samples);
+    build_current(samples, std::mt19937_64(noise_seed));
+  }
+  // The next step's batch depends only on its number: it is built while this one trains.
+  if (ahead_) start_building_ahead(counter + 1);
+  return train_on_current();
 }
 
 TrainStep Trainer::step_on(const std::vector<SampleRef>& samples, std::uint64_t noise_seed) {
-  std::mt19937_64 noise(noise_seed);
-  prepare_batch(samples, noise, /*accumulate=*/true);
+  build_current(samples, std::mt19937_64(noise_seed));
+  return train_on_current();
+}
+
+TrainStep Trainer::train_on_current() {
+  const auto statistics_start = std::chrono::steady_clock::now();
+  accumulate_statistics();
+  times_.statistics += seconds_since(statistics_start);
   TrainStep result;
   result.learning_rate = adam_.learning_rate();
   auto start = std::chrono::steady_clock::now();
@@ -341,8 +395,7 @@ void Trainer::run(std::int64_t steps, const std::function<bool(const TrainStep&)
 }
 
 double Trainer::evaluate_loss(const std::vector<SampleRef>& samples) {
-  std::mt19937_64 noise = step_generator(adam_.step());
-  prepare_batch(samples, noise, /*accumulate=*/false);
+  build_current(samples, step_generator(adam_.step()));
   return loss_and_gradient(false, false);
 }
 

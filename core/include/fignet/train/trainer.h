@@ -6,6 +6,7 @@
 // everywhere.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -21,6 +22,10 @@
 #include "fignet/train/training_batch.h"
 
 namespace fignet {
+
+namespace detail {
+class BackgroundTask;
+}
 
 struct TrainerConfig {
   int batch_size = 4;  // scenes per step over all processes, concatenated into graphs
@@ -67,6 +72,9 @@ struct TrainerState {
 // training: building graphs on the CPU, input statistics, the network's passes, or Adam.
 struct TrainerTimes {
   double build = 0.0, statistics = 0.0, network = 0.0, optimizer = 0.0;
+  // Of `build`, what the steps waited for batches built ahead (set_build_ahead); the rest of it
+  // ran beside the step before.
+  double build_waited = 0.0;
   double warmup = 0.0;  // the statistics warm-up's batches, apart from the steps' phases
 };
 
@@ -88,6 +96,7 @@ class Trainer {
   // The backend holds on to network(): a trainer stays where it was made.
   Trainer(const Trainer&) = delete;
   Trainer& operator=(const Trainer&) = delete;
+  ~Trainer();
 
   // One optimisation step on a random batch (this process's share of it).
   TrainStep step();
@@ -107,6 +116,12 @@ class Trainer {
   // backend by default. Sampling, noise, statistics and Adam are unchanged.
   void set_backend(std::unique_ptr<NetworkBackend> backend);
   const NetworkBackend& backend() const { return *backend_; }
+  // With `on`, step() builds the next step's batch on a thread of its own while this step runs
+  // the network and Adam: for backends that run the passes off the CPU (a GPU), whose cores
+  // would otherwise wait for the graphs. The batches and every bit of the run stay the same.
+  // Off by default: beside the CPU backend the two would share the cores.
+  void set_build_ahead(bool on);
+  bool builds_ahead() const { return ahead_ != nullptr; }
   const Network& network() const { return network_; }
 
   // An immutable snapshot of the model this run produces: the parameters' moving average when
@@ -131,11 +146,43 @@ class Trainer {
   int local_batch_size(int batch) const;
 
  private:
-  // Builds the batch graph and targets; accumulates statistics while they are not frozen.
-  void prepare_batch(const std::vector<SampleRef>& batch, std::mt19937_64& noise, bool accumulate);
-  // Fills scenes_ and their targets for `batch` (noise from one seed per scene, drawn in order
-  // from `noise`) and builds graph_, in parallel parts for large batches.
-  void build_batch_graph(const std::vector<SampleRef>& batch, std::mt19937_64& noise);
+  // A batch ready for the network: its samples' scenes, the graph built from them and the loss's
+  // inputs, with the scratch that built them. Two of them when building ahead: the step's own
+  // and the next one's.
+  struct PreparedBatch {
+    std::vector<SampleRef> samples;  // step()'s draw
+    std::vector<Scene> scenes;
+    std::vector<Points> scene_targets;
+    // Per-scene flags of resting bodies, only when rest_loss_weight != 1.
+    std::vector<std::vector<std::uint8_t>> scene_resting;
+    std::vector<std::uint64_t> scene_seeds;
+    // Batches are built by up to one builder per thread, each into its own part, then appended
+    // in scene order.
+    std::vector<GraphBuilder> builders;
+    std::vector<Graph> part_graphs;
+    Graph graph;
+    RowMatrixXf targets;
+    std::vector<std::uint8_t> in_loss;
+    std::vector<float> loss_weights;  // per node, only when rest_loss_weight != 1
+    double build_seconds = 0.0;       // what building it last took
+  };
+
+  // Builds `samples` into `batch` (noise from one seed per scene, drawn in order from `noise`),
+  // in parallel parts on up to `threads` threads. Reads only the data and the configs: it may run
+  // beside a step.
+  void build_batch(const std::vector<SampleRef>& samples, std::mt19937_64 noise, int threads,
+                   PreparedBatch& batch) const;
+  // build_batch into the current batch, on this thread's OpenMP threads.
+  void build_current(const std::vector<SampleRef>& samples, std::mt19937_64 noise);
+  // Makes the batch built ahead the current one when it was built for step number `counter`
+  // (waiting for it); otherwise drops it. Returns whether it did.
+  bool take_batch_built_ahead(std::int64_t counter);
+  // Starts building the batch of step number `counter` into the other batch.
+  void start_building_ahead(std::int64_t counter);
+  // Statistics, forward, backward and Adam on the current batch.
+  TrainStep train_on_current();
+  PreparedBatch& current() { return batches_[current_]; }
+  const PreparedBatch& current() const { return batches_[current_]; }
   // Adds this step's statistics of every input and of the targets, summed over processes.
   void accumulate_statistics();
   // Mean over every process's dynamic nodes; with `reduce`, counts and gradients are summed
@@ -161,26 +208,20 @@ class Trainer {
   Normalizers normalizers_;
   Adam adam_;
   Collective* collective_;
-  std::vector<SampleRef> samples_, batch_;
+  std::vector<SampleRef> samples_;
   std::unique_ptr<NetworkBackend> backend_;
-  // Scratch reused every step. Batches are built by up to one builder per OpenMP thread, each
-  // into its own part of the batch, then appended in scene order.
-  std::vector<GraphBuilder> builders_;
-  std::vector<Graph> part_graphs_;
-  Graph graph_;
-  std::vector<Scene> scenes_;
-  std::vector<Points> scene_targets_;
-  RowMatrixXf targets_, normalized_targets_;
-  std::vector<std::uint8_t> in_loss_;
-  // Per-node loss weights and the per-scene flags they come from, only when
-  // rest_loss_weight != 1.
-  std::vector<std::vector<std::uint8_t>> scene_resting_;
-  std::vector<float> loss_weights_;
+  // Scratch reused every step.
+  std::array<PreparedBatch, 2> batches_;
+  int current_ = 0;
+  RowMatrixXf normalized_targets_;
   Normalizers batch_statistics_;
   std::vector<double> statistics_buffer_;
-  std::vector<std::uint64_t> scene_seeds_;
   TrainerTimes times_;
   double last_gradient_norm_ = 0.0;
+  // The step number whose batch is being built ahead into the other batch (-1: none), and the
+  // thread that builds it (null unless set_build_ahead). Last: it finishes before the batches go.
+  std::int64_t ahead_counter_ = -1;
+  std::unique_ptr<detail::BackgroundTask> ahead_;
 };
 
 }  // namespace fignet
