@@ -91,6 +91,24 @@ TEST_F(ModelFile, SaveThenLoadIsBitExact) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
 }
 
+// Attributes added after the first model files: a file without them reads as those files were
+// made (the config's defaults; the fixture's model sets each to something else).
+TEST_F(ModelFile, AFileWithoutLaterAttributesReadsWhatOlderFilesWereMadeWith) {
+  {
+    H5::H5File file(path_.string(), H5F_ACC_RDWR);
+    H5::Group config = file.openGroup("config");
+    // (Not those that shape the parameters: their files would not load without them.)
+    for (const char* name : {"face_span_limit", "noise_correction", "random_yaw"}) {
+      config.removeAttr(name);
+    }
+  }
+  const ModelConfig loaded = load_model(path_).config(), defaults;
+  EXPECT_EQ(loaded.graph.face_span_limit, defaults.graph.face_span_limit);
+  EXPECT_EQ(loaded.noise_correction, defaults.noise_correction);
+  EXPECT_FALSE(loaded.random_yaw);
+  EXPECT_TRUE(loaded.graph.contact_motion);  // still in the file
+}
+
 TEST_F(ModelFile, NoObjectCarriesATimeStamp) {
   EXPECT_EQ(testing::objects_with_time_stamps(path_), std::vector<std::string>{});
 }

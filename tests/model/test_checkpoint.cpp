@@ -1,3 +1,4 @@
+#include <H5Cpp.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -69,6 +70,40 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   EXPECT_EQ(resumed.parameters(), uninterrupted.parameters());
   EXPECT_EQ(resumed.optimizer().second_moment(), uninterrupted.optimizer().second_moment());
   EXPECT_EQ(resumed.normalizers().target.mean(), uninterrupted.normalizers().target.mean());
+}
+
+// Fields added to checkpoints after their first files: a file without them reads as those runs
+// trained (the trainer's defaults) and without a planned length.
+TEST_F(Checkpoints, AFileWithoutLaterFieldsReadsWhatOlderRunsTrainedWith) {
+  TrainerConfig trainer_config;
+  trainer_config.gradient_clip = 0.5f;
+  trainer_config.huber_delta = 2.0f;
+  trainer_config.statistics_warmup = 3;
+  trainer_config.rest_loss_weight = 30.0f;
+  trainer_config.still_air_fraction = 0.5f;
+  trainer_config.weight_average = 0.75f;
+  const auto data = falling_cubes();
+  Trainer trainer(tiny_model(), trainer_config, data);
+  const fs::path path = dir_ / "run.ckpt.h5";
+  save_checkpoint(trainer, path, 10);
+  {
+    H5::H5File file(path.string(), H5F_ACC_RDWR);
+    H5::Group training = file.openGroup("training");
+    for (const char* name :
+         {"gradient_clip", "huber_delta", "statistics_warmup", "rest_loss_weight", "weight_average",
+          "still_air_fraction", "planned_steps"}) {
+      training.removeAttr(name);
+    }
+  }
+  const Checkpoint checkpoint = load_checkpoint(path);
+  const TrainerConfig defaults;
+  EXPECT_EQ(checkpoint.trainer_config.gradient_clip, defaults.gradient_clip);
+  EXPECT_EQ(checkpoint.trainer_config.huber_delta, defaults.huber_delta);
+  EXPECT_EQ(checkpoint.trainer_config.statistics_warmup, defaults.statistics_warmup);
+  EXPECT_EQ(checkpoint.trainer_config.rest_loss_weight, defaults.rest_loss_weight);
+  EXPECT_EQ(checkpoint.trainer_config.weight_average, defaults.weight_average);
+  EXPECT_EQ(checkpoint.trainer_config.still_air_fraction, defaults.still_air_fraction);
+  EXPECT_EQ(checkpoint.planned_steps, 0);
 }
 
 // The parameters' moving average: what model() gives, kept in the checkpoint beside the

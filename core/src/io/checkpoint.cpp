@@ -43,19 +43,17 @@ void read_training(const H5::Group& group, size_t parameters, const std::string&
   config.adam.learning_rate_start = static_cast<float>(read_double(group, "learning_rate_start"));
   config.adam.learning_rate_end = static_cast<float>(read_double(group, "learning_rate_end"));
   config.adam.decay_steps = read_integer(group, "decay_steps");
-  // Added later: absent in older checkpoints, which trained without them.
-  if (group.attrExists("gradient_clip"))
-    config.gradient_clip = static_cast<float>(read_double(group, "gradient_clip"));
-  if (group.attrExists("huber_delta"))
-    config.huber_delta = static_cast<float>(read_double(group, "huber_delta"));
-  if (group.attrExists("statistics_warmup"))
-    config.statistics_warmup = static_cast<int>(read_integer(group, "statistics_warmup"));
-  if (group.attrExists("rest_loss_weight"))
-    config.rest_loss_weight = static_cast<float>(read_double(group, "rest_loss_weight"));
-  if (group.attrExists("weight_average"))
-    config.weight_average = static_cast<float>(read_double(group, "weight_average"));
-  if (group.attrExists("still_air_fraction"))
-    config.still_air_fraction = static_cast<float>(read_double(group, "still_air_fraction"));
+  // Added later: absent in older checkpoints, which trained without them (the defaults).
+  auto read_float_or = [&](const char* name, float absent) {
+    return static_cast<float>(read_double_or(group, name, absent));
+  };
+  config.gradient_clip = read_float_or("gradient_clip", config.gradient_clip);
+  config.huber_delta = read_float_or("huber_delta", config.huber_delta);
+  config.statistics_warmup =
+      static_cast<int>(read_integer_or(group, "statistics_warmup", config.statistics_warmup));
+  config.rest_loss_weight = read_float_or("rest_loss_weight", config.rest_loss_weight);
+  config.weight_average = read_float_or("weight_average", config.weight_average);
+  config.still_air_fraction = read_float_or("still_air_fraction", config.still_air_fraction);
   state.step = read_integer(group, "step");
   state.rng = read_string(group, "rng");
   for (auto [name, out] : {std::pair("adam_first_moment", &state.first_moment),
@@ -104,8 +102,7 @@ Checkpoint load_checkpoint(const std::filesystem::path& path) {
     const H5::Group training = file.openGroup("training");
     read_training(training, model->parameters().size(), where, config, state);
     // Absent from checkpoints written before it was recorded.
-    if (training.attrExists("planned_steps"))
-      planned_steps = hdf5::read_integer(training, "planned_steps");
+    planned_steps = hdf5::read_integer_or(training, "planned_steps", 0);
   } catch (const H5::Exception& e) {
     throw FileError(fmt::format("{}: cannot read 'training' ({})", where, e.getDetailMsg()));
   }

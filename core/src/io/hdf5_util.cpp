@@ -103,6 +103,10 @@ long long read_integer_or(const H5::H5Object& object, const std::string& name, l
   return object.attrExists(name) ? read_integer(object, name) : absent;
 }
 
+double read_double_or(const H5::H5Object& object, const std::string& name, double absent) {
+  return object.attrExists(name) ? read_double(object, name) : absent;
+}
+
 std::string read_string(const H5::H5Object& object, const std::string& name) {
   const H5::Attribute attribute = object.openAttribute(name);
   std::string value;

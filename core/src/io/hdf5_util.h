@@ -31,6 +31,7 @@ std::string read_string(const H5::H5Object& object, const std::string& name);
 // An attribute added to a format after its first files: `absent` (what those files were made
 // with) when the file has none.
 long long read_integer_or(const H5::H5Object& object, const std::string& name, long long absent);
+double read_double_or(const H5::H5Object& object, const std::string& name, double absent);
 
 // Row-major datasets of floats or doubles with the given shape.
 void write_floats(H5::Group& group, const std::string& path, const float* data,

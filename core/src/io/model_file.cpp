@@ -85,9 +85,7 @@ ModelConfig read_config(const H5::Group& group) {
   for (int i = 0; i < 3; ++i)
     c.gravity[i] = read_double(group, fmt::format("gravity_{}", "xyz"[i]));
   c.seed = static_cast<std::uint64_t>(read_integer(group, "seed"));
-  if (group.attrExists("mesh_vertices")) {
-    c.mesh_vertices = static_cast<int>(read_integer(group, "mesh_vertices"));
-  }
+  c.mesh_vertices = static_cast<int>(read_integer_or(group, "mesh_vertices", c.mesh_vertices));
   if (group.attrExists("min_mass") && group.attrExists("max_mass")) {
     c.min_mass = read_double(group, "min_mass");
     c.max_mass = read_double(group, "max_mass");
@@ -120,21 +118,17 @@ ModelConfig read_config(const H5::Group& group) {
   c.graph.floor_segments = static_cast<int>(read_integer(group, "floor_segments"));
   // Added after the first model files: absent means what those files were made with.
   auto flag = [&](const char* name, bool absent) {
-    return group.attrExists(name) ? read_integer(group, name) != 0 : absent;
+    return read_integer_or(group, name, absent ? 1 : 0) != 0;
   };
   c.graph.mesh_edges = flag("mesh_edges", true);
   c.graph.static_internal_edges = flag("static_internal_edges", true);
   c.graph.log_mass = flag("log_mass", false);
   c.graph.contact_motion = flag("contact_motion", false);
-  if (group.attrExists("face_span_limit")) {
-    c.graph.face_span_limit = read_double(group, "face_span_limit");
-  }
-  if (group.attrExists("velocity_log_scale")) {
-    c.graph.velocity_log_scale = read_double(group, "velocity_log_scale");
-  }
-  if (group.attrExists("distance_log_scale")) {
-    c.graph.distance_log_scale = read_double(group, "distance_log_scale");
-  }
+  c.graph.face_span_limit = read_double_or(group, "face_span_limit", c.graph.face_span_limit);
+  c.graph.velocity_log_scale =
+      read_double_or(group, "velocity_log_scale", c.graph.velocity_log_scale);
+  c.graph.distance_log_scale =
+      read_double_or(group, "distance_log_scale", c.graph.distance_log_scale);
   if (group.attrExists("noise")) {
     const std::string noise = read_string(group, "noise");
     if (noise != "vertex" && noise != "rigid") {
@@ -142,9 +136,7 @@ ModelConfig read_config(const H5::Group& group) {
     }
     c.noise = noise == "rigid" ? NoiseKind::kRigid : NoiseKind::kVertex;
   }
-  if (group.attrExists("noise_correction")) {
-    c.noise_correction = read_double(group, "noise_correction");
-  }
+  c.noise_correction = read_double_or(group, "noise_correction", c.noise_correction);
   c.random_yaw = flag("random_yaw", false);
   c.validate();
   return c;
