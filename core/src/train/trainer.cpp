@@ -103,6 +103,16 @@ void Trainer::build_current(const std::vector<SampleRef>& samples, std::mt19937_
   times_.build += current().build_seconds;
 }
 
+void Trainer::build_current(std::int64_t counter) {
+  draw_and_build(counter, omp_get_max_threads(), current());
+  times_.build += current().build_seconds;
+}
+
+void Trainer::draw_and_build(std::int64_t counter, int threads, PreparedBatch& batch) const {
+  const std::uint64_t noise_seed = draw_batch(counter, batch.samples);
+  build_batch(batch.samples, std::mt19937_64(noise_seed), threads, batch);
+}
+
 void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64 noise, int threads,
                           PreparedBatch& batch) const {
   const auto start = std::chrono::steady_clock::now();
@@ -216,10 +226,7 @@ void Trainer::start_building_ahead(std::int64_t counter) {
   PreparedBatch& next = batches_[1 - current_];
   // This thread's OpenMP setting: the background thread's own is the process default.
   const int threads = omp_get_max_threads();
-  ahead_->start([this, &next, counter, threads] {
-    const std::uint64_t noise_seed = draw_batch(counter, next.samples);
-    build_batch(next.samples, std::mt19937_64(noise_seed), threads, next);
-  });
+  ahead_->start([this, &next, counter, threads] { draw_and_build(counter, threads, next); });
   ahead_counter_ = counter;
 }
 
@@ -239,9 +246,7 @@ void Trainer::warm_up_statistics(int batches) {
   const double steps_build = times_.build;
   for (int i = 0; i < batches; ++i) {
     // Counters from -1 down: apart from every training step's draws.
-    std::vector<SampleRef>& samples = current().samples;
-    const std::uint64_t noise_seed = draw_batch(-1 - static_cast<std::int64_t>(i), samples);
-    build_current(samples, std::mt19937_64(noise_seed));
+    build_current(-1 - static_cast<std::int64_t>(i));
     accumulate_statistics();
   }
   // Its batches are no step's: the per-step phases stay the steps' own.
@@ -354,11 +359,7 @@ std::uint64_t Trainer::draw_batch(std::int64_t counter, std::vector<SampleRef>& 
 
 TrainStep Trainer::step() {
   const std::int64_t counter = adam_.step();
-  if (!take_batch_built_ahead(counter)) {
-    std::vector<SampleRef>& samples = current().samples;
-    const std::uint64_t noise_seed = draw_batch(counter, samples);
-    build_current(samples, std::mt19937_64(noise_seed));
-  }
+  if (!take_batch_built_ahead(counter)) build_current(counter);
   // The next step's batch depends only on its number: it is built while this one trains.
   if (ahead_) start_building_ahead(counter + 1);
   return train_on_current();

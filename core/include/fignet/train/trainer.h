@@ -150,7 +150,7 @@ class Trainer {
   // inputs, with the scratch that built them. Two of them when building ahead: the step's own
   // and the next one's.
   struct PreparedBatch {
-    std::vector<SampleRef> samples;  // step()'s draw
+    std::vector<SampleRef> samples;  // draw_and_build's draw
     std::vector<Scene> scenes;
     std::vector<Points> scene_targets;
     // Per-scene flags of resting bodies, only when rest_loss_weight != 1.
@@ -172,8 +172,11 @@ class Trainer {
   // beside a step.
   void build_batch(const std::vector<SampleRef>& samples, std::mt19937_64 noise, int threads,
                    PreparedBatch& batch) const;
-  // build_batch into the current batch, on this thread's OpenMP threads.
+  // Draws the batch of draw number `counter` (draw_batch) into batch.samples and builds it.
+  void draw_and_build(std::int64_t counter, int threads, PreparedBatch& batch) const;
+  // build_batch, or draw_and_build, into the current batch on this thread's OpenMP threads.
   void build_current(const std::vector<SampleRef>& samples, std::mt19937_64 noise);
+  void build_current(std::int64_t counter);
   // Makes the batch built ahead the current one when it was built for step number `counter`
   // (waiting for it); otherwise drops it. Returns whether it did.
   bool take_batch_built_ahead(std::int64_t counter);
