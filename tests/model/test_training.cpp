@@ -1,12 +1,11 @@
 #include <gtest/gtest.h>
 
-#include <omp.h>
-
 #include <cmath>
 #include <numbers>
 #include <random>
 
 #include "../graph/scene_fixtures.h"
+#include "../scoped_threads.h"
 #include "fignet/error.h"
 #include "fignet/rollout/predictor.h"
 #include "fignet/rollout/rollout.h"
@@ -45,20 +44,6 @@ ModelConfig noisy_model() {
   return config;
 }
 
-// OpenMP's thread count for one scope.
-class ScopedThreads {
- public:
-  explicit ScopedThreads(int threads) : previous_(omp_get_max_threads()) {
-    omp_set_num_threads(threads);
-  }
-  ~ScopedThreads() { omp_set_num_threads(previous_); }
-  ScopedThreads(const ScopedThreads&) = delete;
-  ScopedThreads& operator=(const ScopedThreads&) = delete;
-
- private:
-  int previous_;
-};
-
 TEST(Trainer, OverfitsOneShortTrajectoryByAHundredfold) {
   const auto data = spinning_cubes(12);
   TrainerConfig trainer_config;
@@ -86,7 +71,7 @@ TEST(Trainer, BatchesDoNotDependOnTheThreadCount) {
   trainer_config.gradient_clip = 0.5f;
   trainer_config.huber_delta = 1.0f;
   auto train = [&](int threads) {
-    const ScopedThreads scope(threads);
+    const testing::ScopedThreads scope(threads);
     Trainer trainer(config, trainer_config, data);
     trainer.warm_up_statistics(2);
     std::vector<double> losses;
@@ -111,7 +96,7 @@ TEST(Trainer, BuildingAheadTrainsTheSameBits) {
   trainer_config.rest_loss_weight = 10.0f;
   trainer_config.weight_average = 0.9f;
   auto train = [&](bool ahead) {
-    const ScopedThreads scope(2);
+    const testing::ScopedThreads scope(2);
     Trainer trainer(noisy_model(), trainer_config, data);
     trainer.set_build_ahead(ahead);
     EXPECT_EQ(trainer.builds_ahead(), ahead);

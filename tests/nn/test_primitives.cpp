@@ -1,9 +1,8 @@
 #include <gtest/gtest.h>
 
-#include <omp.h>
-
 #include <random>
 
+#include "../scoped_threads.h"
 #include "fignet/nn/adam.h"
 #include "fignet/nn/mlp.h"
 #include "fignet/nn/ops.h"
@@ -221,16 +220,14 @@ TEST(Adam, ThreadedUpdatesGiveTheSameBitsAsOneThreadAndFollowTheFormula) {
   const AdamConfig config{
       .learning_rate_start = 1e-2f, .learning_rate_end = 1e-3f, .decay_steps = 10};
   std::vector<std::vector<float>> results;
-  const int saved = omp_get_max_threads();
   for (const int threads : {1, 3}) {
-    omp_set_num_threads(threads);
+    const testing::ScopedThreads scope(threads);
     Adam adam(n, config);
     std::vector<float> x = start;
     adam.update(x, g1);
     adam.update(x, g2);
     results.push_back(x);
   }
-  omp_set_num_threads(saved);
   EXPECT_EQ(results[0], results[1]);
   const double rate0 = 1e-2, rate1 = 1e-2 * std::pow(0.1, 0.1);  // decay over 10 steps
   for (size_t i : {size_t(0), Adam::kParallelBlock - 1, Adam::kParallelBlock, n - 1}) {
