@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "../scoped_threads.h"
 #include "fignet/graph/graph_builder.h"
 #include "fignet/model/network_backend.h"
 #include "fignet/nn/gemm.h"
@@ -64,10 +65,8 @@ struct Batch {
 // Runs f with Eigen::nbThreads() == threads.
 template <class F>
 auto with_threads(int threads, F&& f) {
-  Eigen::setNbThreads(threads);
-  auto result = f();
-  Eigen::setNbThreads(0);
-  return result;
+  const testing::ScopedEigenThreads scope(threads);
+  return f();
 }
 
 double max_abs(const std::vector<float>& a) {

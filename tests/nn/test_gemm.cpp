@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "../scoped_threads.h"
 #include "fignet/error.h"
 #include "fignet/nn/gemm.h"
 
@@ -108,10 +109,9 @@ void expect_same_bits_for_any_thread_count(const RowMatrixXf& a, Transpose op_a,
                                            double tolerance) {
   const RowMatrixXf bt = b.transpose();
   auto run = [&](int threads, Transpose op_b, bool accumulate) {
-    Eigen::setNbThreads(threads);
+    const testing::ScopedEigenThreads scope(threads);
     RowMatrixXf c = start;
     gemm(a, op_a, op_b == Transpose::kNo ? b : bt, op_b, c, accumulate);
-    Eigen::setNbThreads(0);
     return c;
   };
   const MatrixXdRow exact = op_a == Transpose::kNo
@@ -207,10 +207,9 @@ TEST_P(Gemm, BiasAndReluGiveTheSameBitsForAnyThreadCount) {
   const RowMatrixXf a = random_matrix(1500, 64, 5), b = random_matrix(64, 64, 6);
   const RowMatrixXf bias = random_matrix(1, 64, 7);
   auto run = [&](int threads) {
-    Eigen::setNbThreads(threads);
+    const testing::ScopedEigenThreads scope(threads);
     RowMatrixXf c(a.rows(), b.cols());
     gemm_bias(a, b, Transpose::kNo, bias.data(), Activation::kRelu, c);
-    Eigen::setNbThreads(0);
     return c;
   };
   const RowMatrixXf one = run(1);
@@ -246,14 +245,15 @@ TEST_P(Gemm, RowPassesRunOnEveryRowOnceBeforeAndAfterItsProduct) {
     for (Eigen::Index r = first; r < first + rows; ++r) (*p.visits)[r] += 10;
   };
   for (int threads = 1; threads <= 4; ++threads) {
-    Eigen::setNbThreads(threads);
     RowMatrixXf a = RowMatrixXf::Constant(source.rows(), source.cols(), 1e30f);  // unread until set
     RowMatrixXf c(source.rows(), b.cols());
     std::vector<int> visits(source.rows(), 0);
     const Passes passes{&source, &a, &c, &visits};
-    gemm_bias(a, b, Transpose::kNo, bias.data(), Activation::kRelu, c, {+prologue, &passes},
-              {+epilogue, &passes});
-    Eigen::setNbThreads(0);
+    {
+      const testing::ScopedEigenThreads scope(threads);
+      gemm_bias(a, b, Transpose::kNo, bias.data(), Activation::kRelu, c, {+prologue, &passes},
+                {+epilogue, &passes});
+    }
     EXPECT_EQ(c, expected) << threads << " threads";
     EXPECT_EQ(std::count(visits.begin(), visits.end(), 11), source.rows()) << threads;
   }

@@ -151,13 +151,12 @@ TEST(Mlp, ForwardOverManyBlocksMatchesADoublePrecisionMlpForAnyThreadCount) {
     SCOPED_TRACE(blocks_beside ? "column block" : "whole matrix");
     const RowMatrixXf before = random_matrix(rng, kRows, (1 + 2 * blocks_beside) * kOutput);
     auto run = [&](int threads) {
-      Eigen::setNbThreads(threads);
+      const testing::ScopedEigenThreads scope(threads);
       Buffer first;
       MlpCache cache;
       RowMatrixXf wide = before;
       mlp.forward_dense(params.data(), x, first, cache,
                         wide.middleCols(blocks_beside * kOutput, kOutput));
-      Eigen::setNbThreads(0);
       return wide;
     };
     const RowMatrixXf one = run(1);
