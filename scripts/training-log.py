@@ -1,13 +1,19 @@
 #!/usr/bin/env python3
 """The validations of `fignet train` logs (OUT.log.jsonl) as one Markdown table.
 
-Usage: scripts/training-log.py [--batch NAME=B ...] [--fit] [--fit-from SAMPLES] [--plot PNG]
-                               LOG [LOG ...]
+Usage: scripts/training-log.py [--batch NAME=B ...] [--cost NAME=C ...] [--fit]
+                               [--fit-from SAMPLES] [--plot PNG] LOG [LOG ...]
 
 One row per validation of each log: steps, samples seen (the log's "samples"; logs from before
 that field need --batch, and count steps × batch), the rollouts' mean translation and rotation error,
-and the one-step error per regime (free flight, moving contact, rest) in millimetres. The runs of
-a compute-matched comparison are best read side by side at equal samples.
+and the one-step error per regime (free flight, moving contact, rest, and impacts where the log
+has them) in millimetres. The runs of a compute-matched comparison are best read side by side at
+equal samples, and at equal compute when their samples cost differently.
+
+--cost NAME=C says that a sample of the run whose name starts with NAME costs C times a sample of
+the others (e.g. the ratio of the two configs' time per step, measured in one run on one machine):
+the table then has a column of compute, samples × C, in samples of the cheapest run, and --plot
+draws the curves against it.
 
 --fit adds, per log, the learning curve as a power law: a least-squares line through
 ln(translation) against ln(samples) over the validations from --fit-from samples on, its slope
@@ -86,6 +92,9 @@ def main() -> int:
     parser.add_argument("logs", nargs="+", type=pathlib.Path, help="OUT.log.jsonl files")
     parser.add_argument("--batch", action="append", default=[], metavar="NAME=B",
                         help="batch size of the log whose file name starts with NAME")
+    parser.add_argument("--cost", action="append", default=[], metavar="NAME=C",
+                        help="a sample of the run whose name starts with NAME costs C samples of "
+                             "the others (adds a compute column)")
     parser.add_argument("--fit", action="store_true",
                         help="fit a power law to each log's validation translation error")
     parser.add_argument("--fit-from", type=parse_count, default=0.0, metavar="SAMPLES",
@@ -99,11 +108,24 @@ def main() -> int:
         if not size.isdigit():
             parser.error(f"--batch {item}: expected NAME=B with B a number")
         given[name] = int(size)
+    costs = {}
+    for item in args.cost:
+        name, _, factor = item.partition("=")
+        try:
+            costs[name] = float(factor)
+        except ValueError:
+            parser.error(f"--cost {item}: expected NAME=C with C a number")
+        if not name or not costs[name] > 0:
+            parser.error(f"--cost {item}: expected a run name and a cost above 0")
 
     runs = []
+    cost_of = {}
     for log in args.logs:
         name = log.name.removesuffix(".log.jsonl").removesuffix(".h5")
         batch = next((b for prefix, b in given.items() if name.startswith(prefix)), None)
+        # The longest matching prefix, so that "w128=3" and "w128-lr=3.1" can both be given.
+        matches = sorted((prefix for prefix in costs if name.startswith(prefix)), key=len)
+        cost_of[name] = costs[matches[-1]] if matches else 1.0
         try:
             runs.append((name, read_validations(log, batch)))
         except OSError as e:
@@ -113,19 +135,25 @@ def main() -> int:
             print(f"training-log.py: {e}", file=sys.stderr)
             return 1
 
-    print("| run | steps | samples | translation (m) | rotation (°) "
-          "| one step: free flight / moving contact / rest (mm) |")
-    print("|---|---|---|---|---|---|")
+    with_compute = bool(costs)
+    compute_header = " compute |" if with_compute else ""
+    print(f"| run | steps | samples |{compute_header} translation (m) | rotation (°) "
+          "| one step: free flight / moving contact / rest / impacts (mm) |")
+    print("|---|---|---|" + ("---|" if with_compute else "") + "---|---|---|")
     for name, validations in runs:
         for entry in validations:
             seen = entry["samples"]
             samples = f"{seen / 1000:.0f}k" if seen is not None else "?"
+            compute = ""
+            if with_compute:
+                compute = f" {seen * cost_of[name] / 1000:.0f}k |" if seen is not None else " ? |"
             one_step = " / ".join(
                 f"{1e3 * entry[key]:.2f}" if key in entry else "-"
                 for key in ("valid_one_step_m_free_flight", "valid_one_step_m_moving_contact",
-                            "valid_one_step_m_rest"))
-            print(f"| {name} | {entry['step']} | {samples} | {entry['valid_translation_m']:.3f} "
-                  f"| {entry['valid_rotation_deg']:.1f} | {one_step} |")
+                            "valid_one_step_m_rest", "valid_one_step_m_impacts"))
+            print(f"| {name} | {entry['step']} | {samples} |{compute} "
+                  f"{entry['valid_translation_m']:.3f} | {entry['valid_rotation_deg']:.1f} "
+                  f"| {one_step} |")
 
     fits = {}
     if args.fit or args.plot:
@@ -175,18 +203,20 @@ def main() -> int:
             return 1
         figure, axes = plt.subplots(figsize=(7, 4.5))
         for name, validations in runs:
-            known = [(v["samples"], v["valid_translation_m"]) for v in validations if v["samples"]]
+            cost = cost_of[name]
+            known = [(v["samples"] * cost, v["valid_translation_m"]) for v in validations
+                     if v["samples"]]
             if not known:
                 continue
             line, = axes.plot(*zip(*known), "o-", markersize=3, label=name)
             if name in fits:
                 points, (centre, slope, _) = fits[name]
                 ends = [min(s for s, _ in points), 100 * max(s for s, _ in points)]
-                axes.plot(ends, [power_law_at(centre, slope, s) for s in ends], "--",
-                          color=line.get_color(), label=f"{name}: fit, slope {slope:.2f}")
+                axes.plot([cost * s for s in ends], [power_law_at(centre, slope, s) for s in ends],
+                          "--", color=line.get_color(), label=f"{name}: fit, slope {slope:.2f}")
         axes.set_xscale("log")
         axes.set_yscale("log")
-        axes.set_xlabel("samples seen")
+        axes.set_xlabel("compute (samples of the cheapest run)" if with_compute else "samples seen")
         axes.set_ylabel("validation translation error (m)")
         axes.grid(True, which="both", alpha=0.3)
         axes.legend(fontsize=8)

@@ -76,6 +76,31 @@ def test_the_slope_error_is_the_least_squares_one(source_dir, tmp_path):
     assert cells[2] == f"{slope:.3f} ± {math.sqrt(residual / 3 / sxx):.3f}"
 
 
+def test_cost_puts_runs_on_a_common_compute_axis(source_dir, tmp_path):
+    # A run whose samples cost 3x, and the longest matching prefix decides between two costs.
+    write_log(tmp_path / "wide.h5.log.jsonl", [(10_000, 2.0), (20_000, 1.5)])
+    write_log(tmp_path / "wide-slow.h5.log.jsonl", [(10_000, 2.5)])
+    write_log(tmp_path / "base.h5.log.jsonl", [(30_000, 1.8)])
+    result = run_training_log(source_dir, "--cost", "wide=3", "--cost", "wide-slow=4",
+                              *(str(tmp_path / f"{n}.h5.log.jsonl")
+                                for n in ("wide", "wide-slow", "base")))
+    assert result.returncode == 0, result.stderr
+    header = result.stdout.splitlines()[0]
+    assert "| samples | compute |" in header
+    rows = {(cells[0], cells[1]): cells for cells in
+            ([c.strip() for c in line.strip("|").split("|")]
+             for line in result.stdout.splitlines()[2:] if line.startswith("| "))}
+    assert rows[("wide", "2500")][2:4] == ["20k", "60k"]
+    assert rows[("wide-slow", "1250")][2:4] == ["10k", "40k"]
+    assert rows[("base", "3750")][2:4] == ["30k", "30k"]
+    # Without --cost there is no compute column; a cost must be a positive number.
+    plain = run_training_log(source_dir, str(tmp_path / "base.h5.log.jsonl"))
+    assert "compute" not in plain.stdout.splitlines()[0]
+    for bad in ("wide=0", "wide=lots", "=2"):
+        result = run_training_log(source_dir, "--cost", bad, str(tmp_path / "base.h5.log.jsonl"))
+        assert result.returncode == 2 and f"--cost {bad}" in result.stderr
+
+
 def test_bad_logs_and_counts_are_named(source_dir, tmp_path):
     bad = tmp_path / "bad.log.jsonl"
     bad.write_text('{"step": 1}\nnot json\n')
