@@ -12,7 +12,7 @@ equal samples, and at equal compute when their samples cost differently.
 
 --cost NAME=C says that a sample of the run whose name starts with NAME costs C times a sample of
 the others (e.g. the ratio of the two configs' time per step, measured in one run on one machine):
-the table then has a column of compute, samples × C, in samples of the cheapest run, and --plot
+the table then has a column of compute, samples × C, in samples of the runs without --cost, and --plot
 draws the curves against it.
 
 --fit adds, per log, the learning curve as a power law: a least-squares line through
@@ -216,7 +216,7 @@ def main() -> int:
                           "--", color=line.get_color(), label=f"{name}: fit, slope {slope:.2f}")
         axes.set_xscale("log")
         axes.set_yscale("log")
-        axes.set_xlabel("compute (samples of the cheapest run)" if with_compute else "samples seen")
+        axes.set_xlabel("compute (samples of the runs without --cost)" if with_compute else "samples seen")
         axes.set_ylabel("validation translation error (m)")
         axes.grid(True, which="both", alpha=0.3)
         axes.legend(fontsize=8)
