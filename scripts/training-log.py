@@ -216,7 +216,8 @@ def main() -> int:
                           "--", color=line.get_color(), label=f"{name}: fit, slope {slope:.2f}")
         axes.set_xscale("log")
         axes.set_yscale("log")
-        axes.set_xlabel("compute (samples of the runs without --cost)" if with_compute else "samples seen")
+        axes.set_xlabel("compute (samples of the runs without --cost)" if with_compute
+                        else "samples seen")
         axes.set_ylabel("validation translation error (m)")
         axes.grid(True, which="both", alpha=0.3)
         axes.legend(fontsize=8)
