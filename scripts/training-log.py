@@ -12,8 +12,8 @@ equal samples, and at equal compute when their samples cost differently.
 
 --cost NAME=C says that a sample of the run whose name starts with NAME costs C times a sample of
 the others (e.g. the ratio of the two configs' time per step, measured in one run on one machine):
-the table then has a column of compute, samples × C, in samples of the runs without --cost, and --plot
-draws the curves against it.
+the table then has a column of compute, samples × C, in samples of the runs without --cost, and
+--plot draws the curves against it.
 
 --fit adds, per log, the learning curve as a power law: a least-squares line through
 ln(translation) against ln(samples) over the validations from --fit-from samples on, its slope
