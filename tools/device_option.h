@@ -1,4 +1,4 @@
-// `--device cpu|cuda[:N]` and `--tf32` of the commands that run a network, in one place.
+// `--device cpu|cuda[:N]`, `--tf32` and `--bf16` of the commands that run a network, in one place.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -13,12 +13,14 @@ namespace fignet::cli {
 struct DeviceArgs {
   std::string device = "cpu";
   bool tf32 = false;
+  bool bf16 = false;
 };
 
-// Registers --device and --tf32 on `cmd`.
+// Registers --device, --tf32 and --bf16 on `cmd`.
 void add_device_options(CLI::App& cmd, DeviceArgs& args);
-// The backend --device names for `network`: nullptr for the CPU (callers keep their own path).
-// Throws ConfigError for an unknown device or one this build or machine cannot use.
+// The backend --device names for `network`: nullptr for the CPU (callers keep their own path),
+// whose products it sets to bf16 with --bf16 (process-wide: set_gemm_precision). Throws
+// ConfigError for an unknown device, or one or a precision this build or machine cannot use.
 std::unique_ptr<NetworkBackend> make_backend(const DeviceArgs& args, const Network& network);
 
 }  // namespace fignet::cli

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <exception>
 #include <memory>
+#include <string>
 
 #include "commands.h"
 #include "fignet/error.h"
@@ -32,6 +33,9 @@ void add_info_command(CLI::App& app) {
     std::printf("target: portable\n");
 #endif
     std::printf("matrix products: %s\n", fignet::gemm_description().c_str());
+    const std::string bf16 = fignet::gemm_precision_unavailable(fignet::GemmPrecision::kBf16);
+    std::printf("bf16 products (--bf16): %s\n",
+                bf16.empty() ? "available" : ("not here: " + bf16).c_str());
   });
 }
 

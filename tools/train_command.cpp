@@ -18,6 +18,7 @@
 #include "fignet/io/checkpoint.h"
 #include "fignet/io/model_file.h"
 #include "fignet/io/trajectory_file.h"
+#include "fignet/nn/gemm.h"
 #include "fignet/rollout/evaluation.h"
 #include "fignet/train/training_config.h"
 #include "process_group.h"
@@ -221,7 +222,10 @@ void run_train(const TrainArgs& args) {
     // A GPU leaves the cores free while it runs the passes: the next batch is built meanwhile.
     trainer.set_build_ahead(true);
   }
-  if (root) fmt::print("network passes on: {}\n", trainer.backend().name());
+  if (root) {
+    fmt::print("network passes on: {}{}\n", trainer.backend().name(),
+               gemm_precision() == GemmPrecision::kBf16 ? " (bf16 products)" : "");
+  }
   if (!args.resume && config.trainer.statistics_warmup > 0) {
     if (root) fmt::print("statistics warm-up: {} batches", config.trainer.statistics_warmup);
     std::fflush(stdout);

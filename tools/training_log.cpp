@@ -7,6 +7,7 @@
 #include <string>
 
 #include "fignet/error.h"
+#include "fignet/nn/gemm.h"
 #include "text_file.h"
 
 namespace fignet::cli {
@@ -54,14 +55,15 @@ std::int64_t TrainingLog::samples_at(std::int64_t step) const {
 
 void TrainingLog::write_step(std::int64_t step, double loss, float learning_rate,
                              double steps_per_second, double gradient_norm) {
-  out_ << nlohmann::json{{"step", step},
-                         {"samples", samples_at(step)},
-                         {"loss", loss},
-                         {"learning_rate", learning_rate},
-                         {"steps_per_second", steps_per_second},
-                         {"gradient_norm", gradient_norm}}
-              .dump()
-       << std::endl;
+  nlohmann::json line{{"step", step},
+                      {"samples", samples_at(step)},
+                      {"loss", loss},
+                      {"learning_rate", learning_rate},
+                      {"steps_per_second", steps_per_second},
+                      {"gradient_norm", gradient_norm}};
+  // Which steps ran on bf16 products (--bf16): their bits and speed differ from f32 ones.
+  if (gemm_precision() == GemmPrecision::kBf16) line["products"] = "bf16";
+  out_ << line.dump() << std::endl;
 }
 
 void TrainingLog::write_validation(std::int64_t step, const Evaluation& e,

@@ -13,7 +13,10 @@
 // BM_TrainingBatch trains on a batch of 16 scenes as `fignet train` does and reports samples/s:
 // "whole_eigen" is the path before the CPU backend work (the batch as one graph, Eigen products
 // threaded one by one), "chunked" the CPU backend (chunks of scenes in parallel, the build's
-// product engine).
+// product engine), "chunked_bf16" the same with bf16 products (`fignet train --bf16`; skipped
+// where the processor has no bf16 instructions), with one more reference:
+//   bf16_gemm_gflops  gemm() in bf16 on the dominant shape, same threads
+// (sgemm_gflops and ratio stay f32 ones: how far bf16 takes the step past f32's ceiling).
 //
 //   build/release/tests/bench/bench_network
 #include <benchmark/benchmark.h>
@@ -22,6 +25,7 @@
 
 #include <Eigen/Core>
 #include <chrono>
+#include <string>
 
 #include "fignet/graph/graph_builder.h"
 #include "fignet/model/model.h"
@@ -198,8 +202,18 @@ void BM_TrainingStep(benchmark::State& state, const char* preset) {
 // A training batch of 16 scenes (different lattices), forward and backward, as `fignet train`
 // runs it: the batch as one graph with Eigen's products threaded one by one (before), or the CPU
 // backend's chunks in parallel with the build's engine (now).
-void BM_TrainingBatch(benchmark::State& state, const char* preset, bool chunked) {
+enum class BatchPath { kWholeEigen, kChunked, kChunkedBf16 };
+
+void BM_TrainingBatch(benchmark::State& state, const char* preset, BatchPath path) {
   const int threads = static_cast<int>(state.range(0));
+  const bool chunked = path != BatchPath::kWholeEigen, bf16 = path == BatchPath::kChunkedBf16;
+  if (bf16) {
+    const std::string why_not = gemm_precision_unavailable(GemmPrecision::kBf16);
+    if (!why_not.empty()) {
+      state.SkipWithError(("bf16 products: " + why_not).c_str());
+      return;
+    }
+  }
   constexpr int kScenes = 16;
   std::vector<RestingLattice> lattices;
   std::vector<Scene> scenes;
@@ -237,10 +251,16 @@ void BM_TrainingBatch(benchmark::State& state, const char* preset, bool chunked)
     }
     benchmark::DoNotOptimize(grads.data());
   };
+  if (bf16) set_gemm_precision(GemmPrecision::kBf16);
   step();  // buffers grow once
   const auto start = std::chrono::steady_clock::now();
   for (auto _ : state) step();
   const double seconds = seconds_since(start);
+  if (bf16) {
+    state.counters["bf16_gemm_gflops"] =
+        sgemm_gflops(graph.mesh_edges.size() / kScenes, model.config().latent_size, engine);
+    set_gemm_precision(GemmPrecision::kF32);
+  }
   state.counters["mesh_nodes"] = graph.num_mesh_nodes();
   state.counters["samples_per_second"] = kScenes * state.iterations() / seconds;
   // The products' engine of this run for the references: Eigen for the path before.
@@ -271,13 +291,19 @@ BENCHMARK_CAPTURE(BM_TrainingStep, small, "small")
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_TrainingBatch, small_whole_eigen, "small", false)
+BENCHMARK_CAPTURE(BM_TrainingBatch, small_whole_eigen, "small", BatchPath::kWholeEigen)
     ->Arg(1)
     ->Arg(2)
     ->MinTime(3.0)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_TrainingBatch, small_chunked, "small", true)
+BENCHMARK_CAPTURE(BM_TrainingBatch, small_chunked, "small", BatchPath::kChunked)
+    ->Arg(1)
+    ->Arg(2)
+    ->MinTime(3.0)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_TrainingBatch, small_chunked_bf16, "small", BatchPath::kChunkedBf16)
     ->Arg(1)
     ->Arg(2)
     ->MinTime(3.0)

@@ -10,19 +10,13 @@
 #include "../scoped_threads.h"
 #include "fignet/error.h"
 #include "fignet/nn/gemm.h"
+#include "gemm_oracle.h"
 
 namespace fignet {
 namespace {
 
-using MatrixXdRow = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-
-RowMatrixXf random_matrix(Eigen::Index rows, Eigen::Index cols, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  RowMatrixXf m(rows, cols);
-  for (Eigen::Index i = 0; i < m.size(); ++i) m.data()[i] = u(rng);
-  return m;
-}
+using testing::MatrixXdRow;
+using testing::random_matrix;
 
 // Restores the engine a test changed.
 class EngineScope {
@@ -44,34 +38,9 @@ class Gemm : public ::testing::TestWithParam<GemmEngine> {
 TEST_P(Gemm, MatchesADoublePrecisionProductForEveryTransposeAndShape) {
   const EngineScope scope(GetParam());
   // Shapes of the network (thin and wide, K from 3 to hundreds) and odd sizes.
-  const int shapes[][3] = {{1, 1, 1}, {7, 5, 3}, {400, 64, 64}, {33, 192, 64}, {64, 1000, 3}};
-  unsigned seed = 1;
-  for (const auto& shape : shapes) {
-    const int m = shape[0], k = shape[1], n = shape[2];
-    for (Transpose ta : {Transpose::kNo, Transpose::kYes}) {
-      for (Transpose tb : {Transpose::kNo, Transpose::kYes}) {
-        for (bool accumulate : {false, true}) {
-          SCOPED_TRACE(::testing::Message()
-                       << m << "x" << k << "x" << n << " ta " << (ta == Transpose::kYes) << " tb "
-                       << (tb == Transpose::kYes) << " acc " << accumulate);
-          const RowMatrixXf a =
-              ta == Transpose::kNo ? random_matrix(m, k, seed++) : random_matrix(k, m, seed++);
-          const RowMatrixXf b =
-              tb == Transpose::kNo ? random_matrix(k, n, seed++) : random_matrix(n, k, seed++);
-          RowMatrixXf c = random_matrix(m, n, seed++);
-          const MatrixXdRow a_op = ta == Transpose::kNo ? MatrixXdRow(a.cast<double>())
-                                                        : MatrixXdRow(a.cast<double>().transpose());
-          const MatrixXdRow b_op = tb == Transpose::kNo ? MatrixXdRow(b.cast<double>())
-                                                        : MatrixXdRow(b.cast<double>().transpose());
-          const MatrixXdRow expected =
-              (accumulate ? MatrixXdRow(c.cast<double>()) : MatrixXdRow::Zero(m, n)) + a_op * b_op;
-          gemm(a, ta, b, tb, c, accumulate);
-          // float32 accumulation over k terms of size <= 1: error grows like sqrt(k)·eps.
-          EXPECT_LT((c.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-5 * (k + 10));
-        }
-      }
-    }
-  }
+  const testing::ProductShape shapes[] = {
+      {1, 1, 1}, {7, 5, 3}, {400, 64, 64}, {33, 192, 64}, {64, 1000, 3}};
+  testing::expect_gemm_matches_double(shapes, testing::as_given);
 }
 
 TEST_P(Gemm, WorksOnColumnBlocksOfWiderMatrices) {

@@ -39,6 +39,19 @@ std::atomic<GemmEngine>& current_engine() {
   return engine;
 }
 
+std::atomic<GemmPrecision>& current_precision() {
+  static std::atomic<GemmPrecision> precision(GemmPrecision::kF32);
+  return precision;
+}
+
+#ifdef FIGNET_WITH_ONEDNN
+// Whether this product runs in bf16: only on oneDNN (GemmPrecision's contract).
+bool bf16_products(GemmEngine engine) {
+  return engine == GemmEngine::kOneDnn &&
+         current_precision().load(std::memory_order_relaxed) == GemmPrecision::kBf16;
+}
+#endif
+
 void eigen_gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b, Transpose op_b,
                 MatrixRef c, bool accumulate) {
   auto assign = [&](const auto& lhs, const auto& rhs) {
@@ -111,6 +124,19 @@ void gemm_one_thread(GemmEngine engine, const ConstMatrixRef& a, Transpose op_a,
   eigen_gemm_one_thread(a, op_a, b, op_b, c, accumulate);
 }
 
+// A weight gradient's block, c (+)= aᵀ·op_b(b): the engine's product on the calling thread
+// alone, in bf16 where chosen.
+void sum_one_thread(GemmEngine engine, const ConstMatrixRef& a, const ConstMatrixRef& b,
+                    Transpose op_b, MatrixRef c, bool accumulate) {
+#ifdef FIGNET_WITH_ONEDNN
+  if (bf16_products(engine)) {
+    detail::onednn_bf16_sum_one_thread(a, b, op_b, c, accumulate);
+    return;
+  }
+#endif
+  gemm_one_thread(engine, a, Transpose::kYes, b, op_b, c, accumulate);
+}
+
 // Rows of a block of a weight gradient's sum (below). 512 cost 2-4 % of a one-thread training
 // step in partials and short products and gained 3 % on two threads; 2048 measured the same as
 // one product per sum on both (bench_network, 2026-11-23): the threads share the sums of a batch's
@@ -127,7 +153,7 @@ void weight_gradient(GemmEngine engine, const ConstMatrixRef& a, const ConstMatr
   const Eigen::Index m = c.rows(), n = c.cols(), k = a.rows();
   const Eigen::Index blocks = (k + kSumBlockRows - 1) / kSumBlockRows;
   if (blocks == 1) {
-    gemm_one_thread(engine, a, Transpose::kYes, b, op_b, c, accumulate);
+    sum_one_thread(engine, a, b, op_b, c, accumulate);
     return;
   }
   // The partials persist per thread, so a steady-state step does not allocate.
@@ -142,7 +168,7 @@ void weight_gradient(GemmEngine engine, const ConstMatrixRef& a, const ConstMatr
     const ConstMatrixRef b_block = op_b == Transpose::kNo
                                        ? ConstMatrixRef(b.middleRows(first, rows))
                                        : ConstMatrixRef(b.middleCols(first, rows));
-    gemm_one_thread(engine, a.middleRows(first, rows), Transpose::kYes, b_block, op_b, out, false);
+    sum_one_thread(engine, a.middleRows(first, rows), b_block, op_b, out, false);
   };
   detail::parallel_for(static_cast<int>(blocks), threads_for_blocks(),
                        detail::Schedule::kContiguous, run_block);
@@ -173,6 +199,18 @@ void row_products(GemmEngine engine, const ConstMatrixRef& a, const ConstMatrixR
                   Activation activation, RowPass prologue = {}, RowPass epilogue = {}) {
   const Eigen::Index m = c.rows();
   const Eigen::Index blocks = (m + kProductBlockRows - 1) / kProductBlockRows;
+#ifdef FIGNET_WITH_ONEDNN
+  // In bf16, b is rounded once for all blocks, by the calling thread (whose scratch the blocks'
+  // threads then only read).
+  const bool bf16 = bf16_products(engine);
+  detail::Bf16Weights b_bf16;
+  if (bf16) {
+    thread_local detail::AlignedBf16 weights;
+    if (weights.size() < static_cast<size_t>(b.size())) weights.resize(b.size());
+    detail::copy_to_bf16(b, b.rows(), b.cols(), weights.data());
+    b_bf16 = {weights.data(), a.cols(), c.cols(), op_b};
+  }
+#endif
   auto run_block = [&](int block) {
     const Eigen::Index first = block * kProductBlockRows;
     const Eigen::Index rows = std::min(kProductBlockRows, m - first);
@@ -180,6 +218,11 @@ void row_products(GemmEngine engine, const ConstMatrixRef& a, const ConstMatrixR
     const ConstMatrixRef a_rows = a.middleRows(first, rows);
     MatrixRef c_rows = c.middleRows(first, rows);
 #ifdef FIGNET_WITH_ONEDNN
+    if (bf16) {
+      detail::onednn_bf16_rows_one_thread(a_rows, b_bf16, c_rows, accumulate, bias, activation);
+      epilogue(first, rows);
+      return;
+    }
     if (engine == GemmEngine::kOneDnn && rows == kProductBlockRows &&
         detail::onednn_matmul_one_thread(a_rows, b, op_b, c_rows, accumulate, bias, activation)) {
       epilogue(first, rows);
@@ -289,6 +332,36 @@ void bias_activation(const ConstMatrixRef& x, const float* bias, Activation acti
   }
 }
 
+GemmPrecision gemm_precision() {
+  return current_precision().load();
+}
+
+std::string gemm_precision_unavailable(GemmPrecision precision) {
+  if (precision == GemmPrecision::kF32) return {};
+  if (gemm_engine() == GemmEngine::kEigen) {
+    return "the products run on Eigen (FIGNET_GEMM=eigen or set_gemm_engine), bf16 needs oneDNN";
+  }
+#ifdef FIGNET_WITH_ONEDNN
+  if (!detail::onednn_bf16_available()) {
+    return std::string("oneDNN runs ") + isa_name(dnnl_get_effective_cpu_isa()) +
+           " kernels here, without bf16 instructions (they need AVX512-BF16 or AMX: Intel Cooper "
+           "Lake, Sapphire Rapids or newer, AMD Zen 4 or newer; or ONEDNN_MAX_CPU_ISA caps them)";
+  }
+  return {};
+#else
+  return "this build has no oneDNN (configure with FIGNET_WITH_ONEDNN=ON and libdnnl-dev "
+         "installed)";
+#endif
+}
+
+void set_gemm_precision(GemmPrecision precision) {
+  const std::string why_not = gemm_precision_unavailable(precision);
+  if (!why_not.empty()) {
+    throw ConfigError("bf16 products: " + why_not);
+  }
+  current_precision().store(precision);
+}
+
 GemmEngine gemm_engine() {
   return current_engine().load();
 }
@@ -325,7 +398,12 @@ std::string gemm_description() {
   const dnnl_version_t* v = dnnl_version();
   return "oneDNN " + std::to_string(v->major) + "." + std::to_string(v->minor) + "." +
          std::to_string(v->patch) + ", kernels for " + isa_name(dnnl_get_effective_cpu_isa()) +
-         " (chosen at run time); " + block_products_description();
+         " (chosen at run time); " +
+         (gemm_precision() == GemmPrecision::kBf16
+              ? std::string("every product in bf16 (operands rounded to bfloat16, sums in f32) "
+                            "on its matmul primitive (") +
+                    detail::onednn_bf16_block_kernel() + ")"
+              : block_products_description());
 #else
   return "Eigen";
 #endif

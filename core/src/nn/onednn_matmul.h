@@ -11,6 +11,7 @@
 
 #include "fignet/nn/buffer.h"
 #include "fignet/nn/gemm.h"
+#include "nn/bfloat16.h"
 
 namespace fignet::detail {
 
@@ -41,8 +42,38 @@ bool onednn_matmul_one_thread(const ConstMatrixRef& a, const ConstMatrixRef& b, 
                               MatrixRef c, bool accumulate, const float* bias,
                               Activation activation);
 
+// Whether oneDNN runs bfloat16 products on bf16 instructions here (AVX512-BF16 or AMX): its bf16
+// kernels elsewhere convert in software, slower than its f32 ones.
+bool onednn_bf16_available();
+
+// The bf16 products (GemmPrecision::kBf16) on the calling thread alone: both operands rounded to
+// bfloat16, the sums in float32, c in float32. Primitives are compiled per shape, so row counts
+// are padded (zero rows that add nothing): a block of rows to a multiple of kBf16RowQuantum, a
+// weight gradient's sum to a multiple of kBf16SumQuantum; a steady-state step then reuses a few
+// shapes and neither compiles nor allocates. Throws Error with oneDNN's status when it fails.
+constexpr Eigen::Index kBf16RowQuantum = 32;
+constexpr Eigen::Index kBf16SumQuantum = 256;
+
+// op_b(b) as the bf16 operand of row products: op_b's storage (k x n, or n x k transposed), dense.
+struct Bf16Weights {
+  const Bf16* data = nullptr;
+  Eigen::Index k = 0, n = 0;
+  Transpose op = Transpose::kNo;
+};
+
+// c (+)= a·op_b(b), then c = act(c + bias) when `bias` is given (not with `accumulate`); a has at
+// most 256 rows.
+void onednn_bf16_rows_one_thread(const ConstMatrixRef& a, const Bf16Weights& b, MatrixRef c,
+                                 bool accumulate, const float* bias, Activation activation);
+
+// c (+)= aᵀ·op_b(b), a sum over a's rows (a weight gradient's block of rows).
+void onednn_bf16_sum_one_thread(const ConstMatrixRef& a, const ConstMatrixRef& b, Transpose op_b,
+                                MatrixRef c, bool accumulate);
+
 // oneDNN's implementation of the full blocks' primitive on this processor, e.g. "brg:avx512_core"
 // (brgemm kernels) or "gemm:jit" (its sgemm inside: gemm() then calls sgemm itself).
 std::string onednn_block_kernel();
+// The same for the bf16 products' primitive, e.g. "brg:avx512_core_bf16".
+std::string onednn_bf16_block_kernel();
 
 }  // namespace fignet::detail

@@ -62,6 +62,18 @@ GemmEngine gemm_engine();
 // Process-wide; throws ConfigError when the build lacks the engine.
 void set_gemm_engine(GemmEngine engine);
 bool gemm_engine_available(GemmEngine engine);
+// The precision of the products' operands, process-wide like the engine. kF32 by default.
+// kBf16 rounds both operands of every product to bfloat16 (8 significant bits, ~0.4 % relative
+// error in each operand) and sums in float32: on a processor with bf16 instructions (AVX512-BF16
+// or AMX), oneDNN's bf16 kernels run the network's product shapes ~1.3-1.6x as fast as its f32
+// ones (docs/network.md). Only on oneDNN; results still do not depend on the thread count.
+enum class GemmPrecision { kF32, kBf16 };
+GemmPrecision gemm_precision();
+// Throws ConfigError saying why where the build, engine or processor cannot run `precision`.
+void set_gemm_precision(GemmPrecision precision);
+// Why `precision` cannot run here, or "" where it can.
+std::string gemm_precision_unavailable(GemmPrecision precision);
+
 // "oneDNN" or "Eigen".
 const char* gemm_engine_name(GemmEngine engine);
 // What runs the products, for `fignet info` and benchmark reports, e.g. "oneDNN 2.6.3, kernels
