@@ -22,6 +22,12 @@ inline RowMatrixXf random_matrix(Eigen::Index rows, Eigen::Index cols, unsigned 
   return m;
 }
 
+// How far a float32 sum of k products of numbers <= 1 in magnitude may stray from the double one:
+// its error grows like k·eps.
+inline double product_tolerance(Eigen::Index k) {
+  return 1e-5 * static_cast<double>(k + 10);
+}
+
 inline MatrixXdRow as_given(const RowMatrixXf& x) {
   return x.cast<double>();
 }
@@ -30,8 +36,8 @@ struct ProductShape {
   int m, k, n;
 };
 
-// For each m x k x n shape: c (+)= op_a(a)·op_b(b) on random operands in [-1, 1] within float32
-// rounding of the double product of operand(a) and operand(b), whose error grows like k·eps.
+// For each m x k x n shape: c (+)= op_a(a)·op_b(b) on random operands in [-1, 1] within
+// product_tolerance(k) of the double product of operand(a) and operand(b).
 template <class Operand>
 void expect_gemm_matches_double(std::span<const ProductShape> shapes, Operand operand) {
   unsigned seed = 1;
@@ -54,7 +60,7 @@ void expect_gemm_matches_double(std::span<const ProductShape> shapes, Operand op
           const MatrixXdRow expected =
               (accumulate ? MatrixXdRow(c.cast<double>()) : MatrixXdRow::Zero(m, n)) + a_op * b_op;
           gemm(a, ta, b, tb, c, accumulate);
-          EXPECT_LT((c.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-5 * (k + 10));
+          EXPECT_LT((c.cast<double>() - expected).cwiseAbs().maxCoeff(), product_tolerance(k));
         }
       }
     }

@@ -92,11 +92,6 @@ class Bf16Gemm : public ::testing::Test {
   void TearDown() override { set_gemm_precision(GemmPrecision::kF32); }
 };
 
-// f32 sums of k products of numbers <= 1 in magnitude, as in test_gemm.
-double tolerance(Eigen::Index k) {
-  return 1e-5 * static_cast<double>(k + 10);
-}
-
 TEST_F(Bf16Gemm, MatchesADoubleProductOfTheRoundedOperands) {
   // Rows around the padding quanta (32, 256) and sums around 256 and 2048 (the blocks of sums).
   const testing::ProductShape shapes[] = {{1, 1, 1},     {7, 5, 3},    {33, 192, 64},
@@ -132,7 +127,7 @@ TEST_F(Bf16Gemm, BiasAndReluOnColumnBlocksMatchADoubleLinearLayer) {
     expected.rowwise() += bias.cast<double>().row(0);
     expected = expected.cwiseMax(0.0);
     EXPECT_LT((wide_c.middleCols(48, 48).cast<double>() - expected).cwiseAbs().maxCoeff(),
-              tolerance(64));
+              testing::product_tolerance(64));
     EXPECT_EQ(wide_c.leftCols(48), before.leftCols(48));
     EXPECT_EQ(wide_c.rightCols(48), before.rightCols(48));
   }

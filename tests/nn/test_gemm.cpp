@@ -146,7 +146,8 @@ TEST_P(Gemm, BiasAndReluMatchADoublePrecisionLinearLayer) {
         if (activation == Activation::kRelu) expected = expected.cwiseMax(0.0);
         RowMatrixXf c = random_matrix(m, n, seed++);  // overwritten, never read
         gemm_bias(a, b, tb, bias.data(), activation, c);
-        EXPECT_LT((c.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-5 * (k + 10));
+        EXPECT_LT((c.cast<double>() - expected).cwiseAbs().maxCoeff(),
+                  testing::product_tolerance(k));
       }
     }
   }

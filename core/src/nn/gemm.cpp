@@ -402,7 +402,7 @@ std::string gemm_description() {
          (gemm_precision() == GemmPrecision::kBf16
               ? std::string("every product in bf16 (operands rounded to bfloat16, sums in f32) "
                             "on its matmul primitive (") +
-                    detail::onednn_bf16_block_kernel() + ")"
+                    detail::onednn_block_kernel(GemmPrecision::kBf16) + ")"
               : block_products_description());
 #else
   return "Eigen";

@@ -91,21 +91,14 @@ CompiledMatmul compile(const MatmulKey& key) {
 
 }  // namespace
 
-std::string onednn_bf16_block_kernel() {
+std::string onednn_block_kernel(GemmPrecision precision) {
   const OneOmpThread one_thread;
-  const auto bf16 = dnnl::memory::data_type::bf16;
-  return dnnl::matmul::primitive_desc(
-             dnnl::matmul::desc(describe(256, 64, 64, false, bf16),
-                                describe(64, 64, 64, false, bf16), describe(256, 64, 64, false)),
-             cpu_engine())
-      .impl_info_str();
-}
-
-std::string onednn_block_kernel() {
-  const OneOmpThread one_thread;
-  const dnnl::memory::desc block = describe(256, 64, 64, false);
-  const dnnl::memory::desc weights = describe(64, 64, 64, false);
-  return dnnl::matmul::primitive_desc(dnnl::matmul::desc(block, weights, block), cpu_engine())
+  const auto operands = precision == GemmPrecision::kBf16 ? dnnl::memory::data_type::bf16
+                                                          : dnnl::memory::data_type::f32;
+  const dnnl::memory::desc block = describe(256, 64, 64, false, operands);
+  const dnnl::memory::desc weights = describe(64, 64, 64, false, operands);
+  const dnnl::memory::desc result = describe(256, 64, 64, false);
+  return dnnl::matmul::primitive_desc(dnnl::matmul::desc(block, weights, result), cpu_engine())
       .impl_info_str();
 }
 

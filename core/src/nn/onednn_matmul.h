@@ -71,9 +71,8 @@ void onednn_bf16_sum_one_thread(const ConstMatrixRef& a, const ConstMatrixRef& b
                                 MatrixRef c, bool accumulate);
 
 // oneDNN's implementation of the full blocks' primitive on this processor, e.g. "brg:avx512_core"
-// (brgemm kernels) or "gemm:jit" (its sgemm inside: gemm() then calls sgemm itself).
-std::string onednn_block_kernel();
-// The same for the bf16 products' primitive, e.g. "brg:avx512_core_bf16".
-std::string onednn_bf16_block_kernel();
+// (brgemm kernels) or "gemm:jit" (its sgemm inside: gemm() then calls sgemm itself); for bf16
+// operands e.g. "brg:avx512_core_bf16".
+std::string onednn_block_kernel(GemmPrecision precision = GemmPrecision::kF32);
 
 }  // namespace fignet::detail
