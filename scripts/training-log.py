@@ -68,6 +68,13 @@ def power_law_at(centre, slope, samples):
     return math.exp(centre[1] + slope * (math.log(samples) - centre[0]))
 
 
+def longest_prefix_match(by_prefix: dict, name: str, default):
+    """The value given for the longest prefix of `name`, so that "w128=3" and "w128-lr=3.1" can
+    both be given (to --batch or --cost) and each run gets its own."""
+    matches = sorted((prefix for prefix in by_prefix if name.startswith(prefix)), key=len)
+    return by_prefix[matches[-1]] if matches else default
+
+
 def read_validations(log: pathlib.Path, batch):
     """The log's validations as dicts with 'samples' filled in (None when unknown)."""
     validations = []
@@ -122,10 +129,8 @@ def main() -> int:
     cost_of = {}
     for log in args.logs:
         name = log.name.removesuffix(".log.jsonl").removesuffix(".h5")
-        batch = next((b for prefix, b in given.items() if name.startswith(prefix)), None)
-        # The longest matching prefix, so that "w128=3" and "w128-lr=3.1" can both be given.
-        matches = sorted((prefix for prefix in costs if name.startswith(prefix)), key=len)
-        cost_of[name] = costs[matches[-1]] if matches else 1.0
+        batch = longest_prefix_match(given, name, None)
+        cost_of[name] = longest_prefix_match(costs, name, 1.0)
         try:
             runs.append((name, read_validations(log, batch)))
         except OSError as e:

@@ -155,6 +155,23 @@ TEST_F(Bf16Gemm, TheDescriptionSaysBf16) {
   EXPECT_NE(gemm_description().find("bf16"), std::string::npos) << gemm_description();
 }
 
+TEST_F(Bf16Gemm, EigenIsRefusedWhileBf16IsOn) {
+  // Eigen has no bf16 products: switching to it would make them f32 without a word.
+  try {
+    set_gemm_engine(GemmEngine::kEigen);
+    ADD_FAILURE() << "Eigen accepted while bf16 products are on";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("set_gemm_precision"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(gemm_engine(), GemmEngine::kOneDnn);
+  EXPECT_EQ(gemm_precision(), GemmPrecision::kBf16);
+  // Back to f32 first, and the switch is allowed.
+  set_gemm_precision(GemmPrecision::kF32);
+  set_gemm_engine(GemmEngine::kEigen);
+  EXPECT_EQ(gemm_engine(), GemmEngine::kEigen);
+  set_gemm_engine(GemmEngine::kOneDnn);
+}
+
 TEST(GemmPrecision, Bf16IsRefusedWithAReasonWhereItCannotRun) {
   EXPECT_EQ(gemm_precision(), GemmPrecision::kF32);
   EXPECT_EQ(gemm_precision_unavailable(GemmPrecision::kF32), "");

@@ -101,6 +101,22 @@ def test_cost_puts_runs_on_a_common_compute_axis(source_dir, tmp_path):
         assert result.returncode == 2 and f"--cost {bad}" in result.stderr
 
 
+def test_batch_counts_samples_of_old_logs_by_the_longest_prefix(source_dir, tmp_path):
+    # Logs from before the "samples" field: steps × the batch given for the longest prefix of
+    # the run's name, as --cost decides.
+    for name in ("w128", "w128-lr"):
+        with open(tmp_path / f"{name}.h5.log.jsonl", "w") as log:
+            log.write(json.dumps({"step": 1000, "valid_translation_m": 1.0,
+                                  "valid_rotation_deg": 40.0}) + "\n")
+    result = run_training_log(source_dir, "--batch", "w128=8", "--batch", "w128-lr=16",
+                              *(str(tmp_path / f"{n}.h5.log.jsonl") for n in ("w128", "w128-lr")))
+    assert result.returncode == 0, result.stderr
+    rows = {cells[0]: cells for cells in
+            ([c.strip() for c in line.strip("|").split("|")]
+             for line in result.stdout.splitlines()[2:] if line.startswith("| "))}
+    assert rows["w128"][2] == "8k" and rows["w128-lr"][2] == "16k", result.stdout
+
+
 def test_bad_logs_and_counts_are_named(source_dir, tmp_path):
     bad = tmp_path / "bad.log.jsonl"
     bad.write_text('{"step": 1}\nnot json\n')

@@ -381,6 +381,12 @@ void set_gemm_engine(GemmEngine engine) {
                       gemm_engine_name(engine) +
                       " (configure with FIGNET_WITH_ONEDNN=ON and libdnnl-dev installed)");
   }
+  // bf16 products run only on oneDNN: switching them to Eigen would make them f32 unasked.
+  if (engine == GemmEngine::kEigen && gemm_precision() == GemmPrecision::kBf16) {
+    throw ConfigError(
+        "set_gemm_engine: bf16 products are on and run only on oneDNN; "
+        "set_gemm_precision(GemmPrecision::kF32) before switching to Eigen");
+  }
   current_engine().store(engine);
 }
 

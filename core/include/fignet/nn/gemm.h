@@ -59,7 +59,8 @@ void bias_activation(const ConstMatrixRef& x, const float* bias, Activation acti
 // The engine gemm() uses: oneDNN where the build has it, unless the environment variable
 // FIGNET_GEMM=eigen (read once, at the first product) or set_gemm_engine() chose Eigen.
 GemmEngine gemm_engine();
-// Process-wide; throws ConfigError when the build lacks the engine.
+// Process-wide; throws ConfigError when the build lacks the engine, or for Eigen while bf16
+// products are on (they run only on oneDNN; set the precision back to kF32 first).
 void set_gemm_engine(GemmEngine engine);
 bool gemm_engine_available(GemmEngine engine);
 // The precision of the products' operands, process-wide like the engine. kF32 by default.
