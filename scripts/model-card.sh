@@ -10,8 +10,8 @@
 #   curve.md, curve.png         the learning curve and its power-law fit, from MODEL.h5.log.jsonl
 # Needs the README's release build and data/movi-a/test.h5 (the README's `fignet generate`
 # commands). Environment: FIGNET (default build/release/tools/fignet), PYTHON (default python3,
-# or /usr/bin/python3 where only that one has matplotlib, which the plot needs), JOBS (default 2: the measurements run in two lanes of one thread
-# each; 1 runs them one after another).
+# or /usr/bin/python3 where only that one has matplotlib, which the plot needs), JOBS (default
+# 2: the measurements run in two lanes of one thread each; 1 runs them one after another).
 set -euo pipefail
 fignet="${FIGNET:-build/release/tools/fignet}" jobs="${JOBS:-2}" python="${PYTHON:-python3}"
 [[ $# -ge 1 && $# -le 2 ]] || { echo "usage: $0 MODEL.h5 [OUT_DIR]" >&2; exit 2; }
@@ -57,13 +57,15 @@ log="$model.log.jsonl"
 if [[ -f "$log" ]]; then
   # One reading of the log: the table always, the plot where matplotlib is there to draw it.
   plot=(--plot "$out/curve.png")
-  # A python3 first on PATH (pyenv, a venv) may lack the Debian package that the system's has.
-  if ! "$python" -c "import matplotlib" 2>/dev/null && [[ -z "${PYTHON:-}" ]] \
-    && /usr/bin/python3 -c "import matplotlib" 2>/dev/null; then
-    python=/usr/bin/python3
+  if ! "$python" -c "import matplotlib" 2>/dev/null; then
+    # A python3 first on PATH (pyenv, a venv) may lack the Debian package the system's has.
+    if [[ -z "${PYTHON:-}" ]] && /usr/bin/python3 -c "import matplotlib" 2>/dev/null; then
+      python=/usr/bin/python3
+    else
+      plot=()
+      echo "(no matplotlib: curve.png not drawn; Debian's python3-matplotlib draws it)"
+    fi
   fi
-  "$python" -c "import matplotlib" 2>/dev/null \
-    || { plot=(); echo "(no matplotlib: curve.png not drawn; Debian's python3-matplotlib draws it)"; }
   "$python" scripts/training-log.py --fit --fit-from 100k "${plot[@]}" "$log" >"$out/curve.md"
 fi
 grep -h -E "\) +[0-9.]+ +[0-9.]+ +[0-9.]+" "$out/test-turns1.txt" "$out/test-turns2.txt" || true

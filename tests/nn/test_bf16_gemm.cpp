@@ -9,6 +9,7 @@
 #include <limits>
 #include <random>
 
+#include "../error_text.h"
 #include "../scoped_threads.h"
 #include "fignet/error.h"
 #include "fignet/nn/gemm.h"
@@ -157,12 +158,9 @@ TEST_F(Bf16Gemm, TheDescriptionSaysBf16) {
 
 TEST_F(Bf16Gemm, EigenIsRefusedWhileBf16IsOn) {
   // Eigen has no bf16 products: switching to it would make them f32 without a word.
-  try {
-    set_gemm_engine(GemmEngine::kEigen);
-    ADD_FAILURE() << "Eigen accepted while bf16 products are on";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("set_gemm_precision"), std::string::npos) << e.what();
-  }
+  const std::string refusal =
+      testing::error_of<ConfigError>([] { set_gemm_engine(GemmEngine::kEigen); });
+  EXPECT_NE(refusal.find("set_gemm_precision"), std::string::npos) << refusal;
   EXPECT_EQ(gemm_engine(), GemmEngine::kOneDnn);
   EXPECT_EQ(gemm_precision(), GemmPrecision::kBf16);
   // Back to f32 first, and the switch is allowed.
@@ -179,12 +177,9 @@ TEST(GemmPrecision, Bf16IsRefusedWithAReasonWhereItCannotRun) {
   const GemmEngine engine = gemm_engine();
   set_gemm_engine(GemmEngine::kEigen);
   EXPECT_NE(gemm_precision_unavailable(GemmPrecision::kBf16).find("Eigen"), std::string::npos);
-  try {
-    set_gemm_precision(GemmPrecision::kBf16);
-    ADD_FAILURE() << "bf16 products accepted on Eigen";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("bf16"), std::string::npos) << e.what();
-  }
+  const std::string refusal =
+      testing::error_of<ConfigError>([] { set_gemm_precision(GemmPrecision::kBf16); });
+  EXPECT_NE(refusal.find("bf16"), std::string::npos) << refusal;
   EXPECT_EQ(gemm_precision(), GemmPrecision::kF32);
   set_gemm_engine(engine);
 }

@@ -24,6 +24,12 @@ def write_log(path, validations):
                                   "valid_rotation_deg": 40.0}) + "\n")
 
 
+def table_rows(stdout):
+    """The cells of the first table's rows (below its header and rule), stripped."""
+    return [[cell.strip() for cell in line.strip("|").split("|")]
+            for line in stdout.splitlines()[2:] if line.startswith("| ")]
+
+
 def fit_row(stdout, name):
     rows = [line for line in stdout.splitlines() if line.startswith(f"| {name} |")
             and "validations fitted" not in line and "(" in line.split("|")[2]]
@@ -87,9 +93,7 @@ def test_cost_puts_runs_on_a_common_compute_axis(source_dir, tmp_path):
     assert result.returncode == 0, result.stderr
     header = result.stdout.splitlines()[0]
     assert "| samples | compute |" in header
-    rows = {(cells[0], cells[1]): cells for cells in
-            ([c.strip() for c in line.strip("|").split("|")]
-             for line in result.stdout.splitlines()[2:] if line.startswith("| "))}
+    rows = {(cells[0], cells[1]): cells for cells in table_rows(result.stdout)}
     assert rows[("wide", "2500")][2:4] == ["20k", "60k"]
     assert rows[("wide-slow", "1250")][2:4] == ["10k", "40k"]
     assert rows[("base", "3750")][2:4] == ["30k", "30k"]
@@ -111,9 +115,7 @@ def test_batch_counts_samples_of_old_logs_by_the_longest_prefix(source_dir, tmp_
     result = run_training_log(source_dir, "--batch", "w128=8", "--batch", "w128-lr=16",
                               *(str(tmp_path / f"{n}.h5.log.jsonl") for n in ("w128", "w128-lr")))
     assert result.returncode == 0, result.stderr
-    rows = {cells[0]: cells for cells in
-            ([c.strip() for c in line.strip("|").split("|")]
-             for line in result.stdout.splitlines()[2:] if line.startswith("| "))}
+    rows = {cells[0]: cells for cells in table_rows(result.stdout)}
     assert rows["w128"][2] == "8k" and rows["w128-lr"][2] == "16k", result.stdout
 
 
