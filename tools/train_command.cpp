@@ -307,14 +307,18 @@ void run_train(const TrainArgs& args) {
       std::max<double>(1.0, static_cast<double>(trainer.steps_done() - first_step));
   fmt::print(
       "per step ({} scenes): {:.1f} ms building graphs{}, {:.1f} ms input statistics, {:.1f} ms "
-      "network ({}), {:.1f} ms Adam\n",
+      "network ({}), {:.1f} ms Adam{}\n",
       config.trainer.batch_size, 1e3 * times.build / steps_run,
       trainer.builds_ahead()
           ? fmt::format(" ({:.1f} ms of it waited for, the rest beside the step before)",
                         1e3 * times.build_waited / steps_run)
           : "",
       1e3 * times.statistics / steps_run, 1e3 * times.network / steps_run, trainer.backend().name(),
-      1e3 * times.optimizer / steps_run);
+      1e3 * times.optimizer / steps_run,
+      config.trainer.pushforward_fraction > 0.0f
+          ? fmt::format(", {:.1f} ms pushing scenes forward (its forward passes and graphs)",
+                        1e3 * times.pushforward / steps_run)
+          : "");
   if (const std::string profile = trainer.backend().profile(); !profile.empty()) {
     fmt::print("{}: {}\n", trainer.backend().name(), profile);
   }

@@ -47,6 +47,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   trainer_config.adam.decay_steps = 20;
   trainer_config.rest_loss_weight = 30.0f;
   trainer_config.still_air_fraction = 0.5f;
+  trainer_config.pushforward_fraction = 0.5f;
   Trainer uninterrupted(tiny_model(), trainer_config, data);
   uninterrupted.run(10, nullptr);
 
@@ -60,6 +61,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   EXPECT_EQ(checkpoint.trainer_config.adam.decay_steps, 20);
   EXPECT_EQ(checkpoint.trainer_config.rest_loss_weight, 30.0f);
   EXPECT_EQ(checkpoint.trainer_config.still_air_fraction, 0.5f);
+  EXPECT_EQ(checkpoint.trainer_config.pushforward_fraction, 0.5f);
   Trainer resumed(checkpoint.model->config(), checkpoint.trainer_config, data,
                   checkpoint.model.get());
   resumed.restore(checkpoint.state);
@@ -82,6 +84,7 @@ TEST_F(Checkpoints, AFileWithoutLaterFieldsReadsWhatOlderRunsTrainedWith) {
   trainer_config.rest_loss_weight = 30.0f;
   trainer_config.still_air_fraction = 0.5f;
   trainer_config.weight_average = 0.75f;
+  trainer_config.pushforward_fraction = 0.5f;
   const auto data = falling_cubes();
   Trainer trainer(tiny_model(), trainer_config, data);
   const fs::path path = dir_ / "run.ckpt.h5";
@@ -91,7 +94,7 @@ TEST_F(Checkpoints, AFileWithoutLaterFieldsReadsWhatOlderRunsTrainedWith) {
     H5::Group training = file.openGroup("training");
     for (const char* name :
          {"gradient_clip", "huber_delta", "statistics_warmup", "rest_loss_weight", "weight_average",
-          "still_air_fraction", "planned_steps"}) {
+          "still_air_fraction", "pushforward_fraction", "planned_steps"}) {
       training.removeAttr(name);
     }
   }
@@ -103,6 +106,7 @@ TEST_F(Checkpoints, AFileWithoutLaterFieldsReadsWhatOlderRunsTrainedWith) {
   EXPECT_EQ(checkpoint.trainer_config.rest_loss_weight, defaults.rest_loss_weight);
   EXPECT_EQ(checkpoint.trainer_config.weight_average, defaults.weight_average);
   EXPECT_EQ(checkpoint.trainer_config.still_air_fraction, defaults.still_air_fraction);
+  EXPECT_EQ(checkpoint.trainer_config.pushforward_fraction, defaults.pushforward_fraction);
   EXPECT_EQ(checkpoint.planned_steps, 0);
 }
 

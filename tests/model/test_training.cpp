@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -70,6 +71,7 @@ TEST(Trainer, BatchesDoNotDependOnTheThreadCount) {
   trainer_config.batch_size = 16;
   trainer_config.gradient_clip = 0.5f;
   trainer_config.huber_delta = 1.0f;
+  trainer_config.pushforward_fraction = 0.5f;
   auto train = [&](int threads) {
     const testing::ScopedThreads scope(threads);
     Trainer trainer(config, trainer_config, data);
@@ -95,6 +97,7 @@ TEST(Trainer, BuildingAheadTrainsTheSameBits) {
   trainer_config.batch_size = 6;
   trainer_config.rest_loss_weight = 10.0f;
   trainer_config.weight_average = 0.9f;
+  trainer_config.pushforward_fraction = 0.5f;
   auto train = [&](bool ahead) {
     const testing::ScopedThreads scope(2);
     Trainer trainer(noisy_model(), trainer_config, data);
@@ -363,6 +366,161 @@ TEST(Trainer, StillAirSamplesReplaceTheirShareOfScenesAndWeighLikeRestingBodies)
   EXPECT_EQ(loss_with(1.0f, 1.0f, with_pusher), loss_with(0.0f, 1.0f, with_pusher));
   TrainerConfig bad;
   bad.still_air_fraction = 1.5f;
+  EXPECT_THROW(Trainer(small_model(), bad, data), ConfigError);
+}
+
+// A sample drawn a frame early and advanced to the true poses is the sample of its own frame:
+// the history slides, kinematic bodies take their true frames, and the targets are the same.
+TEST(TrainingBatch, AdvancingToTheTruthGivesTheSampleOfTheNextFrame) {
+  auto data = spinning_cubes(10);
+  data[0].objects[1].kinematic = true;
+  const int history = ModelConfig::preset_named("small").graph.history, frame = 5;
+  std::mt19937_64 rng(3);
+  Scene early, expected;
+  Points early_targets, expected_targets;
+  make_noisy_sample(data[0], frame - 1, history, 0.0, NoiseKind::kRigid, 0.0, rng, early,
+                    early_targets);
+  make_noisy_sample(data[0], frame, history, 0.0, NoiseKind::kRigid, 0.0, rng, expected,
+                    expected_targets);
+  std::vector<Pose> truth;
+  for (const TrajectoryObject& object : data[0].objects) truth.push_back(object.poses[frame]);
+  advance_to_predicted(data[0], frame, history, truth, 0.0, early, early_targets);
+  for (size_t o = 0; o < early.objects.size(); ++o) {
+    const SceneObject &got = early.objects[o], &want = expected.objects[o];
+    EXPECT_LT((got.positions - want.positions).cwiseAbs().maxCoeff(), 1e-12) << o;
+    EXPECT_LT((got.centers - want.centers).cwiseAbs().maxCoeff(), 1e-12) << o;
+    if (want.kinematic) {
+      EXPECT_LT((got.next_positions - want.next_positions).cwiseAbs().maxCoeff(), 1e-12);
+    }
+  }
+  EXPECT_LT((early_targets - expected_targets).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+// Advanced to a prediction that is off by a rigid motion, the sample keeps its noisy history
+// (one step older), ends at the prediction, and its targets lead to the true next frame plus the
+// uncorrected share of the prediction's error: the true velocity is given back.
+TEST(TrainingBatch, AdvancingToAWrongPredictionTeachesTheTrueVelocityFromIt) {
+  const auto data = spinning_cubes(10);
+  const int history = ModelConfig::preset_named("small").graph.history, frame = 6;
+  for (double correction : {0.0, 0.5, 1.0}) {
+    std::mt19937_64 rng(11);
+    Scene scene;
+    Points targets;
+    make_noisy_sample(data[0], frame - 1, history, 1e-2, NoiseKind::kRigid, correction, rng, scene,
+                      targets);
+    const Scene early = scene;
+    std::vector<Pose> predicted;
+    for (const TrajectoryObject& object : data[0].objects) {
+      Pose pose = object.poses[frame];
+      pose.position += Vec3(0.01, -0.02, 0.03);
+      pose.orientation = Eigen::AngleAxisd(0.05, Vec3(1, 2, 3).normalized()) * pose.orientation;
+      predicted.push_back(pose);
+    }
+    advance_to_predicted(data[0], frame, history, predicted, correction, scene, targets);
+    Eigen::Index row = 0;
+    for (size_t o = 0; o < scene.objects.size(); ++o) {
+      const SceneObject& object = scene.objects[o];
+      const TriangleMesh& mesh = *object.mesh;
+      const Eigen::Index v = mesh.num_vertices();
+      for (int k = 0; k < history; ++k) {
+        EXPECT_EQ(object.positions_at(k), early.objects[o].positions_at(k + 1)) << k;
+      }
+      const Points now = posed_vertices(mesh, predicted[o]);
+      EXPECT_LT((object.positions_at(history) - now).cwiseAbs().maxCoeff(), 1e-12);
+      EXPECT_LT((object.centers.row(history).transpose() - predicted[o].position).norm(), 1e-12);
+      const Points error = now - posed_vertices(mesh, data[0].objects[o].poses[frame]);
+      const Points next = 2.0 * now - object.positions_at(history - 1) + targets.middleRows(row, v);
+      const Points true_next = posed_vertices(mesh, data[0].objects[o].poses[frame + 1]);
+      EXPECT_LT((next - (true_next + (1.0 - correction) * error)).cwiseAbs().maxCoeff(), 1e-12)
+          << "object " << o << ", correction " << correction;
+      row += v;
+    }
+  }
+  Scene scene;
+  Points targets;
+  std::mt19937_64 rng(1);
+  make_noisy_sample(data[0], history, history, 0.0, NoiseKind::kRigid, 0.0, rng, scene, targets);
+  const std::vector<Pose> one(1);
+  EXPECT_THROW(advance_to_predicted(data[0], history + 1, history, one, 0.0, scene, targets),
+               ConfigError);
+  const std::vector<Pose> two(2);
+  EXPECT_THROW(advance_to_predicted(data[0], history, history, two, 0.0, scene, targets),
+               ConfigError);
+}
+
+// A pushed step trains on the scene advanced to what the network itself predicts from the frame
+// before: the same as predicting that frame with a ModelPredictor of the trainer's model (the
+// inference path, apart from the trainer's) and advancing the sample to it.
+TEST(Trainer, PushforwardTrainsOnTheNetworksOwnPrediction) {
+  const auto data = spinning_cubes(10);
+  const int h = noisy_model().graph.history;
+  const std::vector<SampleRef> samples = {{0, 6}, {0, 4}};
+  TrainerConfig pushing;
+  pushing.batch_size = 2;
+  pushing.pushforward_fraction = 1.0f;
+  Trainer trainer(noisy_model(), pushing, data);
+  const std::shared_ptr<const Model> before = trainer.current_model();
+  trainer.step_on(samples, 7);
+  ASSERT_EQ(trainer.batch_pushed(), (std::vector<std::uint8_t>{1, 1}));
+  // The same draw unpushed, a frame early: the scenes the network saw (same noise seeds).
+  Trainer plain(noisy_model(), {}, data);
+  plain.step_on({{0, 5}, {0, 3}}, 7);
+  ModelPredictor predictor(before, PredictionOptions{.threads = 1, .fit_masses = false});
+  for (size_t b = 0; b < samples.size(); ++b) {
+    Scene expected = plain.batch_scenes()[b];
+    Points expected_targets = plain.batch_targets()[b];
+    std::vector<Pose> next;
+    StepWorkspace workspace;
+    predict_next_poses(predictor, expected, next, workspace);
+    advance_to_predicted(data[0], samples[b].frame, h, next, 0.0, expected, expected_targets);
+    const Scene& got = trainer.batch_scenes()[b];
+    for (size_t o = 0; o < got.objects.size(); ++o) {
+      EXPECT_LT((got.objects[o].positions - expected.objects[o].positions).cwiseAbs().maxCoeff(),
+                1e-6)
+          << "scene " << b << ", object " << o;
+    }
+    EXPECT_LT((trainer.batch_targets()[b] - expected_targets).cwiseAbs().maxCoeff(), 1e-6) << b;
+  }
+  // The prediction is not the truth: the pushed samples differ from their frames' own.
+  plain.step_on(samples, 7);
+  for (size_t b = 0; b < samples.size(); ++b) {
+    EXPECT_GT((trainer.batch_targets()[b] - plain.batch_targets()[b]).cwiseAbs().maxCoeff(), 1e-4);
+  }
+  // The first frame with a history has no frame before it to push from.
+  trainer.step_on({{0, h}, {0, 6}}, 7);
+  EXPECT_EQ(trainer.batch_pushed(), (std::vector<std::uint8_t>{0, 1}));
+}
+
+// Pushing a share of the steps: chosen per step from the step's draw, the other steps unchanged
+// (the same scenes and targets as a run without it), and the statistics warm-up never pushed.
+TEST(Trainer, PushforwardFractionPushesItsShareOfStepsAndLeavesTheOthersAsTheyWere) {
+  const auto data = spinning_cubes(12);
+  TrainerConfig half;
+  half.batch_size = 3;
+  half.pushforward_fraction = 0.5f;
+  TrainerConfig none = half;
+  none.pushforward_fraction = 0.0f;
+  Trainer pushing(noisy_model(), half, data), plain(noisy_model(), none, data);
+  pushing.warm_up_statistics(2);
+  plain.warm_up_statistics(2);
+  EXPECT_EQ(pushing.normalizers().target.mean(), plain.normalizers().target.mean());
+  int pushed_steps = 0;
+  // Targets come from the data and the noise alone: an unpushed step's match whatever the
+  // parameters, a pushed step's differ where its scenes were pushed.
+  for (int i = 0; i < 12; ++i) {
+    pushing.step();
+    plain.step();
+    const bool pushed = std::ranges::any_of(pushing.batch_pushed(), [](auto p) { return p != 0; });
+    pushed_steps += pushed ? 1 : 0;
+    for (size_t b = 0; b < 3; ++b) {
+      EXPECT_EQ(pushing.batch_targets()[b] == plain.batch_targets()[b], !pushing.batch_pushed()[b])
+          << "step " << i << ", scene " << b;
+    }
+  }
+  EXPECT_GT(pushed_steps, 0);
+  EXPECT_LT(pushed_steps, 12);
+  TrainerConfig bad;
+  bad.pushforward_fraction = -0.5f;
   EXPECT_THROW(Trainer(small_model(), bad, data), ConfigError);
 }
 

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "fignet/error.h"
+#include "fignet/rollout/rollout.h"
 #include "parallel/background_task.h"
 #include "parallel/parallel_for.h"
 
@@ -80,6 +81,15 @@ Trainer::Trainer(const ModelConfig& config, const TrainerConfig& trainer_config,
     throw ConfigError(fmt::format("trainer: still_air_fraction = {} (must be in [0, 1]; 0: none)",
                                   trainer_config.still_air_fraction));
   }
+  if (!(trainer_config.pushforward_fraction >= 0.0f &&
+        trainer_config.pushforward_fraction <= 1.0f)) {
+    throw ConfigError(fmt::format("trainer: pushforward_fraction = {} (must be in [0, 1]; 0: none)",
+                                  trainer_config.pushforward_fraction));
+  }
+  if (trainer_config.pushforward_fraction > 0.0f && config.graph.history < 1) {
+    throw ConfigError(
+        "trainer: pushforward_fraction > 0 needs history >= 1 (a velocity to push forward)");
+  }
 }
 
 int Trainer::local_batch_size(int batch) const {
@@ -99,7 +109,7 @@ std::mt19937_64 Trainer::step_generator(std::int64_t step) const {
 Trainer::~Trainer() = default;
 
 void Trainer::build_current(const std::vector<SampleRef>& samples, std::mt19937_64 noise) {
-  build_batch(samples, noise, omp_get_max_threads(), current());
+  build_batch(samples, noise, true, omp_get_max_threads(), current());
   times_.build += current().build_seconds;
 }
 
@@ -110,11 +120,12 @@ void Trainer::build_current(std::int64_t counter) {
 
 void Trainer::draw_and_build(std::int64_t counter, int threads, PreparedBatch& batch) const {
   const std::uint64_t noise_seed = draw_batch(counter, batch.samples);
-  build_batch(batch.samples, std::mt19937_64(noise_seed), threads, batch);
+  // The statistics warm-up's batches (counters below 0) come before any prediction worth pushing.
+  build_batch(batch.samples, std::mt19937_64(noise_seed), counter >= 0, threads, batch);
 }
 
-void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64 noise, int threads,
-                          PreparedBatch& batch) const {
+void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64 noise,
+                          bool may_push, int threads, PreparedBatch& batch) const {
   const auto start = std::chrono::steady_clock::now();
   for (const SampleRef& sample : samples) {
     if (sample.trajectory < 0 || sample.trajectory >= static_cast<int>(data_.size())) {
@@ -122,6 +133,8 @@ void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64
                                     sample.trajectory, data_.size()));
     }
   }
+  // The pushforward finds the samples here (draw_and_build draws them in place).
+  if (&samples != &batch.samples) batch.samples = samples;
   const int h = config_.graph.history;
   const int scenes = static_cast<int>(samples.size());
   batch.scenes.resize(scenes);
@@ -130,6 +143,19 @@ void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64
   // One noise seed per scene, drawn in scene order: the noise does not depend on the threads.
   batch.scene_seeds.resize(scenes);
   for (std::uint64_t& seed : batch.scene_seeds) seed = noise();
+  // Whether this batch is pushed forward, from a generator of its own: runs without the
+  // pushforward draw what they always drew.
+  bool pushes = false;
+  if (may_push && trainer_config_.pushforward_fraction > 0.0f && scenes > 0) {
+    std::seed_seq push_seeds{static_cast<std::uint32_t>(batch.scene_seeds[0]),
+                             static_cast<std::uint32_t>(batch.scene_seeds[0] >> 32),
+                             std::uint32_t{0x9057}};
+    std::mt19937_64 push(push_seeds);
+    pushes = std::uniform_real_distribution<double>(0.0, 1.0)(push) <
+             trainer_config_.pushforward_fraction;
+  }
+  batch.scene_pushed.assign(scenes, 0);
+  batch.scene_yaw.assign(config_.random_yaw ? scenes : 0, 0.0);
   auto make_samples = [&](int begin, int end) {
     for (int b = begin; b < end; ++b) {
       const Trajectory& trajectory = data_[samples[b].trajectory];
@@ -148,18 +174,25 @@ void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64
                                                                 std::log(kStillAirGaps[1]))(still));
         }
       }
+      // A pushed scene starts a frame early; push_forward_current brings it to its own frame.
+      const bool pushed = pushes && gap == 0.0 && samples[b].frame >= h + 1;
+      batch.scene_pushed[b] = pushed ? 1 : 0;
       if (gap > 0.0) {
         make_still_sample_in_air(trajectory, samples[b].frame, h, gap, config_.noise_std,
                                  config_.noise, config_.noise_correction, rng, batch.scenes[b],
                                  batch.scene_targets[b]);
       } else {
-        make_noisy_sample(trajectory, samples[b].frame, h, config_.noise_std, config_.noise,
-                          config_.noise_correction, rng, batch.scenes[b], batch.scene_targets[b]);
+        make_noisy_sample(trajectory, samples[b].frame - (pushed ? 1 : 0), h, config_.noise_std,
+                          config_.noise, config_.noise_correction, rng, batch.scenes[b],
+                          batch.scene_targets[b]);
       }
       // Drawn after the noise: a run without the turn draws the same noise as before it existed.
+      // A pushed scene is turned once it is pushed (the truth it is advanced with is unturned).
       if (config_.random_yaw) {
         std::uniform_real_distribution<double> angle(0.0, 2.0 * std::numbers::pi);
-        turn_about_vertical(angle(rng), batch.scenes[b], batch.scene_targets[b]);
+        batch.scene_yaw[b] = angle(rng);
+        if (!pushed)
+          turn_about_vertical(batch.scene_yaw[b], batch.scenes[b], batch.scene_targets[b]);
       }
       if (weighs_rest()) {
         if (gap > 0.0) {
@@ -172,13 +205,20 @@ void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64
       }
     }
   };
+  build_graph(threads, batch, make_samples);
+  batch.build_seconds = seconds_since(start);
+}
+
+void Trainer::build_graph(int threads, PreparedBatch& batch,
+                          const std::function<void(int, int)>& prepare_scenes) const {
+  const int scenes = static_cast<int>(batch.scenes.size());
   // Contiguous runs of scenes, one run per thread (the graph is the same however they are cut:
   // each part's nodes and edges are appended in scene order).
   const int parts = std::clamp(std::min(threads, scenes), 1, 64);
   while (static_cast<int>(batch.builders.size()) < parts)
     batch.builders.emplace_back(config_.graph);
   if (parts == 1) {
-    make_samples(0, scenes);
+    prepare_scenes(0, scenes);
     batch.builders[0].build(batch.scenes, batch.graph);
   } else {
     if (static_cast<int>(batch.part_graphs.size()) < parts) batch.part_graphs.resize(parts);
@@ -186,7 +226,7 @@ void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64
     // The first part is built straight into the batch graph, the others beside it.
     detail::parallel_for(parts, parts, detail::Schedule::kContiguous, [&](int i) {
       const int begin = scenes * i / parts, end = scenes * (i + 1) / parts;
-      make_samples(begin, end);
+      prepare_scenes(begin, end);
       batch.builders[i].build(all.subspan(begin, end - begin),
                               i == 0 ? batch.graph : batch.part_graphs[i]);
     });
@@ -197,7 +237,48 @@ void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64
     gather_loss_weights(batch.graph, batch.scene_resting, trainer_config_.rest_loss_weight,
                         batch.loss_weights);
   }
-  batch.build_seconds = seconds_since(start);
+}
+
+void Trainer::push_forward_current() {
+  PreparedBatch& batch = current();
+  if (std::none_of(batch.scene_pushed.begin(), batch.scene_pushed.end(),
+                   [](std::uint8_t pushed) { return pushed != 0; })) {
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  // The network's prediction for every scene of the batch as drawn (the pushed ones a frame
+  // early), with the parameters being optimised and no gradient.
+  const ConstMatrixView output =
+      backend_->forward(params_.data(), normalizers_, batch.graph, false);
+  pushforward_accelerations_.resize(output.rows(), 3);
+  normalizers_.target.denormalize(output, pushforward_accelerations_);
+  const Graph& graph = batch.graph;
+  const int h = config_.graph.history;
+  const double correction = config_.noise_correction;
+  // Each pushed scene advanced to its prediction, then turned when random_yaw; in parallel
+  // parts like the first build.
+  auto advance = [&](int begin, int end) {
+    StepWorkspace workspace;
+    std::vector<Pose> next;
+    for (int b = begin; b < end; ++b) {
+      if (!batch.scene_pushed[b]) continue;
+      Scene& scene = batch.scenes[b];
+      Eigen::Index rows = 0;
+      for (const SceneObject& object : scene.objects) rows += object.mesh->num_vertices();
+      const int first_node = graph.object_first_node[graph.scene_first_object[b]];
+      workspace.accelerations =
+          pushforward_accelerations_.middleRows(first_node, rows).cast<double>();
+      integrate_next_poses(scene, next, workspace);
+      const SampleRef& sample = batch.samples[b];
+      advance_to_predicted(data_[sample.trajectory], sample.frame, h, next, correction, scene,
+                           batch.scene_targets[b]);
+      if (config_.random_yaw) {
+        turn_about_vertical(batch.scene_yaw[b], scene, batch.scene_targets[b]);
+      }
+    }
+  };
+  build_graph(omp_get_max_threads(), batch, advance);
+  times_.pushforward += seconds_since(start);
 }
 
 void Trainer::set_build_ahead(bool on) {
@@ -371,6 +452,7 @@ TrainStep Trainer::step_on(const std::vector<SampleRef>& samples, std::uint64_t 
 }
 
 TrainStep Trainer::train_on_current() {
+  push_forward_current();
   const auto statistics_start = std::chrono::steady_clock::now();
   accumulate_statistics();
   times_.statistics += seconds_since(statistics_start);
@@ -398,6 +480,7 @@ void Trainer::run(std::int64_t steps, const std::function<bool(const TrainStep&)
 
 double Trainer::evaluate_loss(const std::vector<SampleRef>& samples) {
   build_current(samples, step_generator(adam_.step()));
+  push_forward_current();
   return loss_and_gradient(false, false);
 }
 

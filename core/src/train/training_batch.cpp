@@ -63,6 +63,21 @@ Points add_history_noise(SceneObject& object, int history, double noise_std, Noi
   return noise;
 }
 
+// Sizes `targets` to one zero row per node of the scene and calls fill(o, object, rows) with
+// each object's block of them.
+template <typename Fill>
+void fill_target_rows(Scene& scene, Points& targets, const Fill& fill) {
+  Eigen::Index rows = 0;
+  for (const SceneObject& object : scene.objects) rows += object.mesh->num_vertices();
+  targets.setZero(rows, 3);
+  Eigen::Index row = 0;
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    const Eigen::Index v = scene.objects[o].mesh->num_vertices();
+    fill(o, scene.objects[o], targets.middleRows(row, v));
+    row += v;
+  }
+}
+
 // Noise on every dynamic object's history, and its target rows from its clean next positions
 // (`clean_next(o)`): the velocity noise is undone, and the share `position_correction` of the
 // last position's noise too (the rest is kept).
@@ -70,21 +85,12 @@ template <typename CleanNext>
 void add_noise_and_targets(Scene& scene, int history, double noise_std, NoiseKind kind,
                            double position_correction, std::mt19937_64& rng,
                            const CleanNext& clean_next, Points& targets) {
-  Eigen::Index rows = 0;
-  for (const SceneObject& object : scene.objects) rows += object.mesh->num_vertices();
-  targets.setZero(rows, 3);
-  Eigen::Index row = 0;
-  for (size_t o = 0; o < scene.objects.size(); ++o) {
-    SceneObject& object = scene.objects[o];
-    const Eigen::Index v = object.mesh->num_vertices();
-    if (!object.kinematic) {
-      const Points noise = add_history_noise(object, history, noise_std, kind, rng);
-      targets.middleRows(row, v) = clean_next(o) - 2.0 * object.positions_at(history) +
-                                   object.positions_at(history - 1) +
-                                   (1.0 - position_correction) * noise;
-    }
-    row += v;
-  }
+  fill_target_rows(scene, targets, [&](size_t o, SceneObject& object, auto rows) {
+    if (object.kinematic) return;
+    const Points noise = add_history_noise(object, history, noise_std, kind, rng);
+    rows = clean_next(o) - 2.0 * object.positions_at(history) + object.positions_at(history - 1) +
+           (1.0 - position_correction) * noise;
+  });
 }
 
 }  // namespace
@@ -99,6 +105,42 @@ void make_noisy_sample(const Trajectory& trajectory, int frame, int history, dou
         return posed_vertices(*scene.objects[o].mesh, trajectory.objects[o].poses[frame + 1]);
       },
       targets);
+}
+
+void advance_to_predicted(const Trajectory& trajectory, int frame, int history,
+                          std::span<const Pose> predicted, double position_correction, Scene& scene,
+                          Points& targets) {
+  if (predicted.size() != trajectory.objects.size() || scene.objects.size() != predicted.size()) {
+    throw ConfigError(fmt::format(
+        "advance_to_predicted: {} predicted poses and {} scene objects for {} trajectory objects",
+        predicted.size(), scene.objects.size(), trajectory.objects.size()));
+  }
+  if (history < 1 || frame < history + 1 || frame + 1 >= trajectory.num_frames()) {
+    throw ConfigError(fmt::format(
+        "advance_to_predicted: frame {} with history {} (needs history >= 1 and a frame in {} .. "
+        "{}: one before the history and one after)",
+        frame, history, history + 1, trajectory.num_frames() - 2));
+  }
+  fill_target_rows(scene, targets, [&](size_t o, SceneObject& object, auto rows) {
+    const TrajectoryObject& truth = trajectory.objects[o];
+    if (object.kinematic) {
+      const std::span<const Pose> poses(truth.poses);
+      set_pose_history(object, poses.subspan(frame - history, history + 1), poses[frame + 1]);
+      return;
+    }
+    // The noisy history slides one step older and ends at the prediction.
+    const Eigen::Index v = object.mesh->num_vertices();
+    for (int k = 0; k < history; ++k) {
+      object.positions.middleRows(k * v, v) = object.positions.middleRows((k + 1) * v, v).eval();
+      object.centers.row(k) = object.centers.row(k + 1).eval();
+    }
+    const Points now = posed_vertices(*object.mesh, predicted[o]);
+    const Points error = now - posed_vertices(*object.mesh, truth.poses[frame]);
+    object.positions.middleRows(history * v, v) = now;
+    object.centers.row(history) = predicted[o].position.transpose();
+    rows = posed_vertices(*object.mesh, truth.poses[frame + 1]) - 2.0 * now +
+           object.positions_at(history - 1) + (1.0 - position_correction) * error;
+  });
 }
 
 bool can_hold_still_in_air(const Trajectory& trajectory) {

@@ -125,6 +125,8 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.still_air_fraction; })},
       {"weight_average",
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.weight_average; })},
+      {"pushforward_fraction",
+       plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.pushforward_fraction; })},
       {"statistics_warmup",
        plain<int>([](TrainingConfig & c) -> auto& { return c.trainer.statistics_warmup; })},
       {"data_seed",
@@ -312,6 +314,12 @@ void TrainingConfig::validate() const {
         "still_air_fraction = {} (must be in [0, 1]: the share of samples whose bodies are held "
         "still in the air and let go; 0: none)",
         trainer.still_air_fraction));
+  }
+  if (!(trainer.pushforward_fraction >= 0.0f && trainer.pushforward_fraction <= 1.0f)) {
+    throw ConfigError(fmt::format(
+        "pushforward_fraction = {} (must be in [0, 1]: the share of steps that train on the "
+        "network's own one-step prediction; 0: none)",
+        trainer.pushforward_fraction));
   }
   if (!(trainer.weight_average >= 0.0f && trainer.weight_average < 1.0f)) {
     throw ConfigError(fmt::format(

@@ -55,6 +55,14 @@ struct TrainerConfig {
   // (model(), validation, the --out file): it smooths the step-to-step noise that makes
   // successive checkpoints of one run differ by as much as recipes do.
   float weight_average = 0.0f;
+  // Share of the steps whose scenes are pushed forward (the pushforward trick of Brandstetter et
+  // al., 2022): each scene is drawn one frame earlier, the network predicts its next frame
+  // without a gradient, and the step trains on the scene advanced to that prediction
+  // (advance_to_predicted), so the model learns to correct the errors it makes itself, which a
+  // rollout feeds it, besides the training noise (0: none). Scenes at the first frame with a
+  // history and still bodies in the air are not pushed. Costs one forward pass and one graph
+  // build more per pushed step.
+  float pushforward_fraction = 0.0f;
 };
 
 // Everything besides the model that makes training continue exactly where it stopped: the
@@ -76,6 +84,9 @@ struct TrainerTimes {
   // ran beside the step before.
   double build_waited = 0.0;
   double warmup = 0.0;  // the statistics warm-up's batches, apart from the steps' phases
+  // The pushforward's own forward passes and graph builds (pushforward_fraction), apart from the
+  // phases above.
+  double pushforward = 0.0;
 };
 
 struct TrainStep {
@@ -131,6 +142,11 @@ class Trainer {
   std::shared_ptr<const Model> current_model() const;
   std::int64_t steps_done() const { return adam_.step(); }
   const std::vector<SampleRef>& samples() const { return samples_; }
+  // The last step's scenes and their target rows as it trained on them (after the pushforward),
+  // and which of them were pushed forward: for tests and debugging.
+  const std::vector<Scene>& batch_scenes() const { return current().scenes; }
+  const std::vector<Points>& batch_targets() const { return current().scene_targets; }
+  const std::vector<std::uint8_t>& batch_pushed() const { return current().scene_pushed; }
 
   // Checkpoints: state() with model() captures training; restore() continues it exactly.
   TrainerState state() const;
@@ -150,12 +166,17 @@ class Trainer {
   // inputs, with the scratch that built them. Two of them when building ahead: the step's own
   // and the next one's.
   struct PreparedBatch {
-    std::vector<SampleRef> samples;  // draw_and_build's draw
+    std::vector<SampleRef> samples;  // what it was built from (draw_and_build's draw, or step_on's)
     std::vector<Scene> scenes;
     std::vector<Points> scene_targets;
     // Per-scene flags of resting bodies, only when rest_loss_weight != 1.
     std::vector<std::vector<std::uint8_t>> scene_resting;
     std::vector<std::uint64_t> scene_seeds;
+    // Per scene: 1 where it was drawn a frame early to be pushed forward before the step
+    // (pushforward_fraction), and its turn about the vertical when random_yaw (applied after
+    // the push).
+    std::vector<std::uint8_t> scene_pushed;
+    std::vector<double> scene_yaw;
     // Batches are built by up to one builder per thread, each into its own part, then appended
     // in scene order.
     std::vector<GraphBuilder> builders;
@@ -168,10 +189,11 @@ class Trainer {
   };
 
   // Builds `samples` into `batch` (noise from one seed per scene, drawn in order from `noise`),
-  // in parallel parts on up to `threads` threads. Reads only the data and the configs: it may run
-  // beside a step.
-  void build_batch(const std::vector<SampleRef>& samples, std::mt19937_64 noise, int threads,
-                   PreparedBatch& batch) const;
+  // in parallel parts on up to `threads` threads; with `may_push`, draws whether the batch is
+  // pushed forward (its scenes then a frame early). Reads only the data and the configs: it may
+  // run beside a step.
+  void build_batch(const std::vector<SampleRef>& samples, std::mt19937_64 noise, bool may_push,
+                   int threads, PreparedBatch& batch) const;
   // Draws the batch of draw number `counter` (draw_batch) into batch.samples and builds it.
   void draw_and_build(std::int64_t counter, int threads, PreparedBatch& batch) const;
   // build_batch, or draw_and_build, into the current batch on this thread's OpenMP threads.
@@ -182,6 +204,13 @@ class Trainer {
   bool take_batch_built_ahead(std::int64_t counter);
   // Starts building the batch of step number `counter` into the other batch.
   void start_building_ahead(std::int64_t counter);
+  // Builds the graph of batch.scenes in up to `threads` parts, each first running
+  // `prepare_scenes(begin, end)` on its own run of scenes, then the targets and loss weights.
+  void build_graph(int threads, PreparedBatch& batch,
+                   const std::function<void(int, int)>& prepare_scenes) const;
+  // Advances the current batch's pushed scenes to the network's own prediction of their next
+  // frame and rebuilds its graph (pushforward_fraction); nothing when none is pushed.
+  void push_forward_current();
   // Statistics, forward, backward and Adam on the current batch.
   TrainStep train_on_current();
   PreparedBatch& current() { return batches_[current_]; }
@@ -217,6 +246,7 @@ class Trainer {
   std::array<PreparedBatch, 2> batches_;
   int current_ = 0;
   RowMatrixXf normalized_targets_;
+  RowMatrixXf pushforward_accelerations_;
   Normalizers batch_statistics_;
   std::vector<double> statistics_buffer_;
   TrainerTimes times_;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <random>
+#include <span>
 #include <vector>
 
 #include "fignet/data/trajectory.h"
@@ -29,6 +30,18 @@ std::vector<SampleRef> enumerate_samples(const std::vector<Trajectory>& data, in
 void make_noisy_sample(const Trajectory& trajectory, int frame, int history, double noise_std,
                        NoiseKind kind, double position_correction, std::mt19937_64& rng,
                        Scene& scene, Points& targets);
+
+// Moves a sample made at frame − 1 (make_noisy_sample) on to `frame`, with the dynamic bodies'
+// current poses taken from `predicted` (one per object of the trajectory: a model's own
+// prediction from the sample) instead of the truth: their history drops its oldest step and ends
+// at the prediction, kinematic objects take their true frames. The target rows are
+// make_noisy_sample's with the prediction's error x'ᵗ − xᵗ in the place of the position noise:
+// x^{t+1} − 2x'ᵗ + x̃^{t−1} + (1 − c)·(x'ᵗ − xᵗ), so that with c = 0 the model learns to give back
+// the true velocity from its own error (the pushforward trick: training inputs from the
+// distribution a rollout feeds the model, not only noise around the truth).
+void advance_to_predicted(const Trajectory& trajectory, int frame, int history,
+                          std::span<const Pose> predicted, double position_correction, Scene& scene,
+                          Points& targets);
 
 // Whether make_still_sample_in_air can use the trajectory: it has no kinematic objects (a pusher's
 // motion could meet the lifted bodies, and the target would not be gravity alone).
