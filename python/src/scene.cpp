@@ -5,6 +5,8 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "bindings.h"
@@ -14,6 +16,7 @@
 #include "fignet/bullet/scene_spec.h"
 #include "fignet/error.h"
 #include "fignet/geometry/mesh.h"
+#include "fignet/rollout/predictor.h"
 
 namespace fignet::python {
 
@@ -152,6 +155,7 @@ class PyScene {
       simulation_ = std::make_unique<bullet::BulletSimulation>(spec_);
       return;
     }
+    warn_of_unfamiliar_materials();
     bullet::SolverSettings one_step;
     one_step.steps_per_frame = 1;  // the network steps once per frame
     simulation_ = std::make_unique<bullet::BulletSimulation>(
@@ -162,6 +166,48 @@ class PyScene {
           learned_world_ = world.get();
           return world;
         });
+  }
+
+  // One UserWarning naming the bodies, and the floor, whose friction or restitution lie outside
+  // the model's training data: add_body's defaults are Bullet's (restitution 0), which no MOVi
+  // material has, and there the network guesses (a resting body may slide).
+  void warn_of_unfamiliar_materials() const {
+    const ModelConfig& config = model_->config();
+    std::vector<std::string> outside;
+    for (size_t b = 0; b < spec_.bodies.size(); ++b) {
+      const BodySpec& body = spec_.bodies[b];
+      if (body.kinematic || familiar_material(body.properties, config)) continue;
+      // add_body names an unnamed body "body <index>": said once.
+      const std::string label = fmt::format("body {}", b);
+      const std::string name =
+          body.mesh->name() == label ? label : fmt::format("{} '{}'", label, body.mesh->name());
+      outside.push_back(fmt::format("{} (friction {:g}, restitution {:g})", name,
+                                    body.properties.friction, body.properties.restitution));
+    }
+    if (spec_.floor && !familiar_floor(*spec_.floor, config)) {
+      outside.push_back(fmt::format("the floor (friction {:g}, restitution {:g})",
+                                    spec_.floor->properties.friction,
+                                    spec_.floor->properties.restitution));
+    }
+    if (outside.empty()) return;
+    const size_t shown = std::min<size_t>(outside.size(), 4);
+    std::string list;
+    for (size_t i = 0; i < shown; ++i) list += (i ? "; " : "") + outside[i];
+    if (outside.size() > shown) list += fmt::format("; and {} more", outside.size() - shown);
+    auto range = [](const DataRange& r) {
+      if (!r.known()) return std::string("unknown");
+      return r.lowest == r.highest ? fmt::format("{:g}", r.lowest)
+                                   : fmt::format("{:g} to {:g}", r.lowest, r.highest);
+    };
+    const std::string line = fmt::format(
+        "materials outside the model's training data, where it guesses: {}. The model saw bodies "
+        "of friction {} and restitution {} (floor: friction {}, restitution {}); pass friction= "
+        "and restitution= within them to add_body",
+        list, range(config.friction), range(config.restitution), range(config.floor_friction),
+        range(config.floor_restitution));
+    py::module_::import("warnings")
+        .attr("warn")(line, py::module_::import("builtins").attr("UserWarning"),
+                      1);  // step()'s caller
   }
 
   std::shared_ptr<Model> model_;

@@ -1,5 +1,7 @@
 """The scene API: bodies from numpy, stepped by a model or by native Bullet."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -29,6 +31,28 @@ def test_free_flight_with_a_model_is_exact(model):
     np.testing.assert_allclose(scene.positions[0], semi_implicit_euler(p0, v0, 12, scene.time_step),
                                rtol=0, atol=1e-9)
     np.testing.assert_allclose(scene.quaternions[0], [1, 0, 0, 0], atol=1e-12)
+
+
+def test_materials_outside_the_models_data_are_named_in_one_warning(model):
+    scene = fignet.Scene(model)
+    scene.add_floor(friction=0.9)
+    vertices, faces = box(0.3)
+    scene.add_body(vertices, faces, name="plain", position=(0, 0, 5))  # Bullet's restitution 0
+    scene.add_body(vertices, faces, friction=0.4, restitution=0.3, position=(3, 0, 5))  # MOVi metal
+    with pytest.warns(UserWarning) as warned:
+        scene.step(1)
+    lines = [str(w.message) for w in warned if "training data" in str(w.message)]
+    assert len(lines) == 1
+    assert "body 0 'plain' (friction 0.5, restitution 0)" in lines[0]
+    assert "body 1" not in lines[0]
+    assert "the floor (friction 0.9, restitution 0.5)" in lines[0]
+    assert "bodies of friction 0.4 to 0.8 and restitution 0.3 to 0.7" in lines[0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        scene.step(1)  # said once, at the first step
+        native = fignet.Scene()  # native Bullet has no training data to be outside of
+        native.add_body(vertices, faces)
+        native.step(1)
 
 
 def test_native_bullet_falls_as_gravity_says():
