@@ -47,12 +47,6 @@ double shift_difference(const Trajectory& far, const Trajectory& near, const Vec
   return largest;
 }
 
-// "0.3" for a range of one value, else "0.4-0.8".
-std::string range_text(const DataRange& range) {
-  return range.lowest == range.highest ? fmt::format("{:.3g}", range.lowest)
-                                       : fmt::format("{:.3g}-{:.3g}", range.lowest, range.highest);
-}
-
 using NamedModels = std::vector<std::pair<std::string, std::shared_ptr<const Model>>>;
 
 // Per model that records its data's materials, the cases whose dynamic bodies or floor lie
@@ -82,8 +76,8 @@ std::string unfamiliar_materials(const std::vector<bullet::StressCase>& cases,
     text += fmt::format(
         "\nMaterials outside {}'s training data (bodies: friction {}, restitution {}; floor: "
         "friction {}, restitution {}), where it guesses: {}.\n",
-        name, range_text(c.friction), range_text(c.restitution), range_text(c.floor_friction),
-        range_text(c.floor_restitution), fmt::join(listed, "; "));
+        name, c.friction.text(), c.restitution.text(), c.floor_friction.text(),
+        c.floor_restitution.text(), fmt::join(listed, "; "));
   }
   return text;
 }

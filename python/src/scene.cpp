@@ -8,6 +8,7 @@
 #include <algorithm>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "bindings.h"
 #include "fignet/bullet/bullet_simulation.h"
@@ -191,20 +192,14 @@ class PyScene {
     }
     if (outside.empty()) return;
     const size_t shown = std::min<size_t>(outside.size(), 4);
-    std::string list;
-    for (size_t i = 0; i < shown; ++i) list += (i ? "; " : "") + outside[i];
-    if (outside.size() > shown) list += fmt::format("; and {} more", outside.size() - shown);
-    auto range = [](const DataRange& r) {
-      if (!r.known()) return std::string("unknown");
-      return r.lowest == r.highest ? fmt::format("{:g}", r.lowest)
-                                   : fmt::format("{:g} to {:g}", r.lowest, r.highest);
-    };
+    const std::string more =
+        outside.size() > shown ? fmt::format("; and {} more", outside.size() - shown) : "";
     const std::string line = fmt::format(
-        "materials outside the model's training data, where it guesses: {}. The model saw bodies "
-        "of friction {} and restitution {} (floor: friction {}, restitution {}); pass friction= "
-        "and restitution= within them to add_body",
-        list, range(config.friction), range(config.restitution), range(config.floor_friction),
-        range(config.floor_restitution));
+        "materials outside the model's training data, where it guesses: {}{}. The model saw "
+        "bodies of friction {} and restitution {} (floor: friction {}, restitution {}); pass "
+        "friction= and restitution= within them to add_body",
+        fmt::join(outside.begin(), outside.begin() + shown, "; "), more, config.friction.text(),
+        config.restitution.text(), config.floor_friction.text(), config.floor_restitution.text());
     py::module_::import("warnings")
         .attr("warn")(line, py::module_::import("builtins").attr("UserWarning"),
                       1);  // step()'s caller

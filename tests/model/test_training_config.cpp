@@ -126,6 +126,16 @@ TEST(DataRange, WidensToHoldEachValueAndHoldsEverythingWhileUnknown) {
   EXPECT_FALSE(range.holds(0.81));
 }
 
+// What messages print of a range: stress's materials line and the Python scene's warning.
+TEST(DataRange, TextIsOneValueARangeOrUnknown) {
+  DataRange range;
+  EXPECT_EQ(range.text(), "unknown");
+  range.add(0.3);
+  EXPECT_EQ(range.text(), "0.3");
+  range.add(0.7);
+  EXPECT_EQ(range.text(), "0.3-0.7");
+}
+
 // fignet train lets decay_steps follow --steps unless a --set or --config named it.
 TEST(TrainingConfig, RemembersWhetherDecayStepsWasGiven) {
   TrainingConfig config = TrainingConfig::preset_named("small");

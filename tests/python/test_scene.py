@@ -46,7 +46,7 @@ def test_materials_outside_the_models_data_are_named_in_one_warning(model):
     assert "body 0 'plain' (friction 0.5, restitution 0)" in lines[0]
     assert "body 1" not in lines[0]
     assert "the floor (friction 0.9, restitution 0.5)" in lines[0]
-    assert "bodies of friction 0.4 to 0.8 and restitution 0.3 to 0.7" in lines[0]
+    assert "bodies of friction 0.4-0.8 and restitution 0.3-0.7" in lines[0]
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         scene.step(1)  # said once, at the first step

@@ -22,6 +22,12 @@ bool DataRange::holds(double value) const {
   return !known() || (value >= lowest - slack && value <= highest + slack);
 }
 
+std::string DataRange::text() const {
+  if (!known()) return "unknown";
+  return lowest == highest ? fmt::format("{:.3g}", lowest)
+                           : fmt::format("{:.3g}-{:.3g}", lowest, highest);
+}
+
 const std::vector<std::string>& ModelConfig::preset_names() {
   static const std::vector<std::string> names = {"paper", "small"};
   return names;

@@ -31,6 +31,8 @@ struct DataRange {
   void add(double value);
   // Whether `value` lies within the range, up to float32 rounding of the data; true when unknown.
   bool holds(double value) const;
+  // For messages: "0.3" for a range of one value, "0.4-0.8", or "unknown".
+  std::string text() const;
 };
 
 struct ModelConfig {
