@@ -21,6 +21,10 @@ with the slope's standard error, and where the line reaches at 10x and 100x the 
 samples (with the range the slope's standard error gives). Successive validations of one run
 scatter by 10-30 %, so the fit says how the curve trends, not what a longer run will measure.
 --plot writes the curves and their fits on log-log axes (needs matplotlib).
+
+Logs of runs with --valid-stress get a second table: per validation and stress case, the drift of
+bodies started at rest (or the error against Bullet) and the late speed, for the network alone
+and for the world as users get it.
 """
 import argparse
 import json
@@ -90,6 +94,22 @@ def read_validations(log: pathlib.Path, batch):
     return validations
 
 
+def read_stress(log: pathlib.Path):
+    """The log's stress lines (`fignet train --valid-stress`), in order."""
+    return [entry for entry in map(json.loads, log.read_text().splitlines())
+            if "stress" in entry]
+
+
+def stress_cell(figures) -> str:
+    """One simulator's figures of a case: drift (started at rest) or error, and the late speed."""
+    if not figures.get("finite", False):
+        return "not finite"
+    late = f", late {figures['late_speed_m_s']:.2f} m/s"
+    if "drift_m" in figures:
+        return f"{figures['drift_m']:.3f} m / {figures['drift_deg']:.1f}°{late}"
+    return f"error {figures['error_m']:.3f} m{late}"
+
+
 def format_count(value: float) -> str:
     return f"{value / 1e6:.2f}M" if value >= 1e6 else f"{value / 1e3:.0f}k"
 
@@ -126,6 +146,7 @@ def main() -> int:
             parser.error(f"--cost {item}: expected a run name and a cost above 0")
 
     runs = []
+    stress_runs = []
     cost_of = {}
     for log in args.logs:
         name = log.name.removesuffix(".log.jsonl").removesuffix(".h5")
@@ -133,6 +154,7 @@ def main() -> int:
         cost_of[name] = longest_prefix_match(costs, name, 1.0)
         try:
             runs.append((name, read_validations(log, batch)))
+            stress_runs.append((name, read_stress(log)))
         except OSError as e:
             print(f"training-log.py: {log}: {e.strerror}", file=sys.stderr)
             return 1
@@ -197,6 +219,18 @@ def main() -> int:
             print(f"| {name} | {len(points)} ({format_count(min(s for s, _ in points))}–"
                   f"{format_count(last)}) | {slope:.3f}{spread} | {at_last:.3f} m "
                   f"| {reach(10)} | {reach(100)} |")
+    if any(entries for _, entries in stress_runs):
+        print("\n| run | step | samples | stress case | network alone | world |")
+        print("|---|---|---|---|---|---|")
+        for name, entries in stress_runs:
+            for entry in entries:
+                seen = entry.get("samples")
+                samples = f"{seen / 1000:.0f}k" if seen is not None else "?"
+                for case, by_simulator in entry["stress"].items():
+                    print(f"| {name} | {entry['step']} | {samples} | {case} "
+                          f"| {stress_cell(by_simulator.get('network_alone', {}))} "
+                          f"| {stress_cell(by_simulator.get('world', {}))} |")
+
     if args.plot:
         try:
             import matplotlib

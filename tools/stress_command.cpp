@@ -24,7 +24,7 @@ namespace fs = std::filesystem;
 struct StressArgs {
   std::vector<fs::path> models;
   fs::path markdown;
-  std::string only;
+  std::vector<std::string> only;
   double length = 1.0;
   int turns = 1;
   std::string command_line;
@@ -88,12 +88,7 @@ void run_stress(const StressArgs& args) {
     models.emplace_back(file.filename().string(), std::make_shared<const Model>(load_model(file)));
   }
   const std::vector<bullet::Simulator> sims = bullet::stress_simulators(models, args.turns);
-  std::vector<bullet::StressCase> cases = bullet::stress_cases(args.length);
-  std::erase_if(cases, [&](const bullet::StressCase& c) {
-    return !args.only.empty() && c.name.find(args.only) == std::string::npos &&
-           c.group != args.only;
-  });
-  if (cases.empty()) throw ConfigError(fmt::format("--case '{}': no such case", args.only));
+  const std::vector<bullet::StressCase> cases = bullet::select_stress_cases(args.only, args.length);
 
   std::string table =
       "| case | simulator | finite | lowest point (m) | drift (m / deg) | late speed (m/s) | "
@@ -162,7 +157,10 @@ void add_stress_command(CLI::App& app) {
   cmd->add_option("--model", args->models, "Model file (repeatable; none: native Bullet only)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--markdown", args->markdown, "Also write the table as a Markdown document");
-  cmd->add_option("--case", args->only, "Only the cases whose name contains this, or a group");
+  cmd->add_option("--case", args->only,
+                  "Only the cases whose name contains this, or a group (repeatable: any of them)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option("--length", args->length,
                   "Scale every case's length (1: as specified, e.g. 2000 steps at rest)")
       ->check(CLI::Range(0.001, 10.0))
@@ -175,7 +173,7 @@ void add_stress_command(CLI::App& app) {
   cmd->callback([args] {
     std::string line = "build/release/tools/fignet stress";
     for (const fs::path& m : args->models) line += " --model " + m.string();
-    if (!args->only.empty()) line += " --case '" + args->only + "'";
+    for (const std::string& only : args->only) line += " --case '" + only + "'";
     if (args->length != 1.0) line += fmt::format(" --length {}", args->length);
     if (args->turns != 1) line += fmt::format(" --turns {}", args->turns);
     if (!args->markdown.empty()) line += " --markdown " + args->markdown.string();

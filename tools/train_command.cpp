@@ -1,6 +1,7 @@
 // `fignet train`: trains a model on trajectory files with periodic validation rollouts, atomic
 // checkpoints, exact resume, and a clean stop on Ctrl-C / SIGTERM.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <omp.h>
 
 #include <algorithm>
@@ -14,6 +15,7 @@
 
 #include "commands.h"
 #include "device_option.h"
+#include "fignet/bullet/stress.h"
 #include "fignet/error.h"
 #include "fignet/io/checkpoint.h"
 #include "fignet/io/model_file.h"
@@ -42,6 +44,8 @@ struct TrainArgs {
   double checkpoint_minutes = 10.0;
   std::int64_t log_every = 100, valid_every = 2000;
   int valid_trajectories = 10, threads = 0;
+  std::vector<std::string> valid_stress;  // stress cases run at each validation
+  double valid_stress_length = 1.0;
   DeviceArgs device;
 };
 
@@ -145,6 +149,23 @@ void apply_resume_settings(const std::vector<std::string>& settings, TrainingCon
   config.model = changed.model;
 }
 
+// One validation's stress cases in a line: each case's drift (started at rest) or error against
+// Bullet, the network alone / the world (runs 1 and 2 of stress_simulators with one model).
+std::string stress_summary(const std::vector<bullet::StressCase>& cases,
+                           const std::vector<std::vector<bullet::StressRun>>& runs) {
+  std::vector<std::string> parts;
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const auto value = [&](const bullet::StressRun& run) {
+      if (!run.finite) return std::string("not finite");
+      return fmt::format("{:.3f}", cases[i].at_rest ? run.drift : run.error);
+    };
+    parts.push_back(fmt::format("{} {} {} / {} m", cases[i].name,
+                                cases[i].at_rest ? "drift" : "error", value(runs[i][1]),
+                                value(runs[i][2])));
+  }
+  return fmt::format("{}", fmt::join(parts, "; "));
+}
+
 void run_train(const TrainArgs& args) {
   // Before any thread of OpenMP starts: those threads inherit the blocked signals.
   StopSignals stop_signals;
@@ -164,6 +185,12 @@ void run_train(const TrainArgs& args) {
   // prints, logs and writes checkpoints.
   const ProcessGroup& group = process_group();
   const bool root = group.is_root();
+  // A misspelt stress case fails here, not at the first validation.
+  std::vector<bullet::StressCase> stress_cases;
+  if (root && !args.valid_stress.empty()) {
+    stress_cases =
+        bullet::select_stress_cases(args.valid_stress, args.valid_stress_length, "--valid-stress");
+  }
   const std::vector<Trajectory> data =
       read_trajectories(args.data, TrajectoryShare{group.rank(), group.size()});
   std::vector<Trajectory> valid;
@@ -210,9 +237,12 @@ void run_train(const TrainArgs& args) {
   }
   if (root) {
     fmt::print("config:\n{}\n", config.to_json());
-    fmt::print("data: {} trajectories{}; validation: {} trajectories\n", data.size(),
+    fmt::print("data: {} trajectories{}; validation: {} trajectories{}\n", data.size(),
                group.size() > 1 ? fmt::format(" on process 0 of {}", group.size()) : "",
-               valid.size());
+               valid.size(),
+               stress_cases.empty() ? ""
+                                    : fmt::format(" and {} stress case{}", stress_cases.size(),
+                                                  stress_cases.size() == 1 ? "" : "s"));
   }
 
   Trainer trainer(config.model, config.trainer, data, initial.get(), group.collective);
@@ -248,6 +278,39 @@ void run_train(const TrainArgs& args) {
     if (group.size() > 1) group.collective->sum(std::span<double>(&stop, 1));
     return stop > 0.0;
   };
+  // Validation (process 0): rollouts of the held-out trajectories with the one-step errors by
+  // regime, and the stress cases asked for, the network alone and the world as users get it.
+  auto validate = [&](std::int64_t step) {
+    if (!root || (valid.empty() && stress_cases.empty())) return;
+    // One thread per trajectory or case (Eigen runs each predictor's products on its own thread
+    // inside a parallel region; 0 leaves its process-wide setting alone).
+    const std::shared_ptr<const Model> model = trainer.model();
+    const int threads = std::max(1, omp_get_max_threads());
+    if (!valid.empty()) {
+      const auto make_predictor = [&] { return std::make_unique<ModelPredictor>(model, 0); };
+      const Evaluation e = evaluate_rollouts_parallel(make_predictor, valid, threads);
+      // Where the error is: free flight, moving contact, rest (in the model's units too).
+      const Eigen::RowVectorXf& target_std = model->normalizers().target.std();
+      const OneStepTotals one_step = one_step_totals_parallel(
+          make_predictor, model->config().graph, Vec3(target_std(0), target_std(1), target_std(2)),
+          valid, threads);
+      log->write_validation(step, e, one_step);
+      fmt::print(
+          stderr,
+          "\nstep {}: validation translation {:.4f} m, rotation {:.2f} deg; one step: free "
+          "flight {:.2f} mm, moving contact {:.2f} mm, rest {:.2f} mm\n",
+          step, e.mean_translation, e.mean_rotation, 1e3 * mean_translation(one_step.regimes[0]),
+          1e3 * mean_translation(one_step.regimes[1]), 1e3 * mean_translation(one_step.regimes[2]));
+    }
+    if (!stress_cases.empty()) {
+      const std::vector<bullet::Simulator> sims =
+          bullet::stress_simulators({{args.out.filename().string(), model}}, 1, 0);
+      const auto runs = bullet::run_stress_cases(stress_cases, sims, threads);
+      log->write_stress(step, stress_cases, runs);
+      fmt::print(stderr, "step {}: stress (network alone / world): {}\n", step,
+                 stress_summary(stress_cases, runs));
+    }
+  };
   ProgressBar bar(root ? "train" : "", config.steps, trainer.steps_done());
   const std::int64_t first_step = trainer.steps_done();
   auto last_checkpoint = std::chrono::steady_clock::now();
@@ -271,27 +334,7 @@ void run_train(const TrainArgs& args) {
       loss_sum = 0.0, norm_sum = 0.0, loss_count = 0;
       window_start_step = step.step, window_start_time = now;
     }
-    if (!valid.empty() && (step.step % args.valid_every == 0 || step.step == config.steps)) {
-      // One thread per trajectory (Eigen runs each predictor's products on its own thread
-      // inside a parallel region; 0 leaves its process-wide setting alone).
-      const std::shared_ptr<const Model> model = trainer.model();
-      const auto make_predictor = [&] { return std::make_unique<ModelPredictor>(model, 0); };
-      const int threads = std::max(1, omp_get_max_threads());
-      const Evaluation e = evaluate_rollouts_parallel(make_predictor, valid, threads);
-      // Where the error is: free flight, moving contact, rest (in the model's units too).
-      const Eigen::RowVectorXf& target_std = model->normalizers().target.std();
-      const OneStepTotals one_step = one_step_totals_parallel(
-          make_predictor, model->config().graph, Vec3(target_std(0), target_std(1), target_std(2)),
-          valid, threads);
-      log->write_validation(step.step, e, one_step);
-      fmt::print(stderr,
-                 "\nstep {}: validation translation {:.4f} m, rotation {:.2f} deg; one step: free "
-                 "flight {:.2f} mm, moving contact {:.2f} mm, rest {:.2f} mm\n",
-                 step.step, e.mean_translation, e.mean_rotation,
-                 1e3 * mean_translation(one_step.regimes[0]),
-                 1e3 * mean_translation(one_step.regimes[1]),
-                 1e3 * mean_translation(one_step.regimes[2]));
-    }
+    if (step.step % args.valid_every == 0 || step.step == config.steps) validate(step.step);
     const auto now = std::chrono::steady_clock::now();
     if (std::chrono::duration<double>(now - last_checkpoint).count() >=
         60.0 * args.checkpoint_minutes) {
@@ -391,6 +434,17 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--valid-trajectories", args->valid_trajectories,
                   "Validation trajectories rolled out each time")
       ->check(CLI::Range(1, 100'000))
+      ->capture_default_str();
+  cmd->add_option("--valid-stress", args->valid_stress,
+                  "Also run these cases of `fignet stress` at each validation, the network alone "
+                  "and the world, and log their drift and late speed (a name's part or a group, "
+                  "as stress --case; repeatable), e.g. --valid-stress rest --valid-stress stacks")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_option(
+         "--valid-stress-length", args->valid_stress_length,
+         "Scale the stress cases' lengths (as stress --length; 1: e.g. 2000 steps at rest)")
+      ->check(CLI::Range(0.001, 10.0))
       ->capture_default_str();
   cmd->add_option("--threads", args->threads, "OpenMP threads (0: every core)")
       ->check(CLI::Range(0, 1024))

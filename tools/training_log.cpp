@@ -88,4 +88,33 @@ void TrainingLog::write_validation(std::int64_t step, const Evaluation& e,
   out_ << line.dump() << std::endl;
 }
 
+void TrainingLog::write_stress(std::int64_t step, const std::vector<bullet::StressCase>& cases,
+                               const std::vector<std::vector<bullet::StressRun>>& runs) {
+  nlohmann::json stress = nlohmann::json::object();
+  for (size_t i = 0; i < cases.size(); ++i) {
+    nlohmann::json by_simulator = nlohmann::json::object();
+    for (size_t s = 1; s < runs[i].size(); ++s) {
+      const bullet::StressRun& run = runs[i][s];
+      nlohmann::json figures{{"finite", run.finite}};
+      // A run that went non-finite has no meaningful figure (JSON has no NaN).
+      if (run.finite) {
+        figures["lowest_m"] = run.lowest;
+        figures["late_speed_m_s"] = run.late_speed;
+        if (cases[i].at_rest) {
+          figures["drift_m"] = run.drift;
+          figures["drift_deg"] = run.drift_degrees;
+        } else {
+          figures["error_m"] = run.error;
+        }
+      }
+      by_simulator[s == 1   ? "network_alone"
+                   : s == 2 ? "world"
+                            : fmt::format("run_{}", s)] = std::move(figures);
+    }
+    stress[cases[i].name] = std::move(by_simulator);
+  }
+  nlohmann::json line{{"step", step}, {"samples", samples_at(step)}, {"stress", std::move(stress)}};
+  out_ << line.dump() << std::endl;
+}
+
 }  // namespace fignet::cli

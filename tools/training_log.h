@@ -5,7 +5,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
+#include "fignet/bullet/stress.h"
 #include "fignet/rollout/evaluation.h"
 #include "fignet/rollout/one_step.h"
 
@@ -26,6 +28,12 @@ class TrainingLog {
   // Validation rollouts and the one-step errors by regime of the same trajectories.
   void write_validation(std::int64_t step, const Evaluation& evaluation,
                         const OneStepTotals& one_step);
+  // The stress cases run at a validation, each by stress_simulators with one model: Bullet (the
+  // reference), the network alone, the world. One line: {"stress": {case: {"network_alone":
+  // {...}, "world": {...}}}} with finite, lowest_m, late_speed_m_s, and drift_m / drift_deg for
+  // cases started at rest or error_m for the others.
+  void write_stress(std::int64_t step, const std::vector<bullet::StressCase>& cases,
+                    const std::vector<std::vector<bullet::StressRun>>& runs);
 
  private:
   std::int64_t samples_at(std::int64_t step) const;

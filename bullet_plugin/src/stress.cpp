@@ -1,11 +1,16 @@
 #include "fignet/bullet/stress.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
+#include <numeric>
 
 #include "fignet/bullet/fignet_dynamics_world.h"
+#include "fignet/error.h"
 #include "fignet/geometry/mass_properties.h"
 #include "fignet/geometry/shapes.h"
 #include "fignet/graph/scene.h"
@@ -212,8 +217,37 @@ std::vector<StressCase> stress_cases(double scale_frames) {
   return cases;
 }
 
+std::vector<StressCase> select_stress_cases(const std::vector<std::string>& filters,
+                                            double scale_frames, std::string_view option) {
+  std::vector<StressCase> cases = stress_cases(scale_frames);
+  if (filters.empty()) return cases;
+  const auto matches = [](const StressCase& c, const std::string& filter) {
+    return c.name.find(filter) != std::string::npos || c.group == filter;
+  };
+  for (const std::string& filter : filters) {
+    if (std::none_of(cases.begin(), cases.end(),
+                     [&](const StressCase& c) { return matches(c, filter); })) {
+      std::vector<std::string> groups;
+      for (const StressCase& c : cases) {
+        if (std::find(groups.begin(), groups.end(), c.group) == groups.end()) {
+          groups.push_back(c.group);
+        }
+      }
+      throw ConfigError(
+          fmt::format("{} '{}': no such case (no case's name contains it; the groups are {})",
+                      option, filter, fmt::join(groups, ", ")));
+    }
+  }
+  std::erase_if(cases, [&](const StressCase& c) {
+    return std::none_of(filters.begin(), filters.end(),
+                        [&](const std::string& filter) { return matches(c, filter); });
+  });
+  return cases;
+}
+
 std::vector<Simulator> stress_simulators(
-    const std::vector<std::pair<std::string, std::shared_ptr<const Model>>>& models, int turns) {
+    const std::vector<std::pair<std::string, std::shared_ptr<const Model>>>& models, int turns,
+    int world_threads) {
   std::vector<Simulator> sims;
   sims.push_back({"Bullet 240 Hz", {}, {}});
   for (const auto& [name, model] : models) {
@@ -225,6 +259,7 @@ std::vector<Simulator> stress_simulators(
       FIGNetWorldOptions options =
           alone ? FIGNetWorldOptions::network_alone() : FIGNetWorldOptions{};
       options.turns = turns;
+      options.threads = world_threads;
       std::string variant = alone ? "network alone" : "";
       if (turns > 1) variant += fmt::format("{}{} turns", variant.empty() ? "" : ", ", turns);
       if (!variant.empty()) variant = " (" + variant + ")";
@@ -280,6 +315,35 @@ std::vector<StressRun> run_stress_case(const StressCase& c, const std::vector<Si
     }
     runs.push_back(std::move(run));
   }
+  return runs;
+}
+
+std::vector<std::vector<StressRun>> run_stress_cases(const std::vector<StressCase>& cases,
+                                                     const std::vector<Simulator>& sims,
+                                                     int threads) {
+  // Longest first (frames times bodies), so that a long pile does not start last.
+  std::vector<size_t> order(cases.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  const auto work = [&](size_t i) {
+    return static_cast<double>(cases[i].scene.frames) *
+           static_cast<double>(std::max<size_t>(1, cases[i].scene.bodies.size()));
+  };
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return work(a) > work(b); });
+  std::vector<std::vector<StressRun>> runs(cases.size());
+  // An exception must not leave the parallel region: the first is kept and rethrown after it.
+  std::exception_ptr failure;
+  const int n = static_cast<int>(cases.size());
+#pragma omp parallel for num_threads(std::max(1, std::min(threads, n))) schedule(dynamic, 1)
+  for (int k = 0; k < n; ++k) {
+    try {
+      runs[order[k]] = run_stress_case(cases[order[k]], sims);
+    } catch (...) {
+#pragma omp critical(fignet_stress_failure)
+      if (!failure) failure = std::current_exception();
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
   return runs;
 }
 

@@ -2,6 +2,9 @@
 // anywhere, and no body through the floor at 10, 20 and 50 m/s.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
+#include "../error_text.h"
 #include "fignet/bullet/stress.h"
 #include "fignet/io/model_file.h"
 
@@ -81,6 +84,67 @@ TEST(Stress, TheMoviCubeStartsWhereBulletRestsIt) {
     return;
   }
   FAIL() << "no case named 'MOVi cube at rest'";
+}
+
+std::vector<std::string> names(const std::vector<StressCase>& cases) {
+  std::vector<std::string> out;
+  for (const StressCase& c : cases) out.push_back(c.name);
+  return out;
+}
+
+// Filters pick by a part of the name or a whole group; several pick the cases any of them names,
+// once each and in the suite's order, whatever the filters' order.
+TEST(Stress, SelectingCasesByNameAndGroup) {
+  const std::vector<StressCase> all = stress_cases(0.01);
+  EXPECT_EQ(names(select_stress_cases({}, 0.01)), names(all));
+  std::vector<std::string> expected;
+  for (const StressCase& c : all) {
+    if (c.group == "stacks" || c.name == "10-object pile at rest") expected.push_back(c.name);
+  }
+  ASSERT_EQ(expected.size(), 7u);  // the pile, stacks of 2-5 cubes and of 2-3 MOVi cubes
+  EXPECT_EQ(names(select_stress_cases({"stacks", "pile at rest", "stack of 2"}, 0.01)), expected);
+  EXPECT_EQ(names(select_stress_cases({"rest"}, 0.01)),
+            (std::vector<std::string>{"one cube at rest", "MOVi cube at rest",
+                                      "10-object pile at rest"}));
+  EXPECT_EQ(names(select_stress_cases({"MOVi cube at rest"}, 0.01)),
+            std::vector<std::string>{"MOVi cube at rest"});
+}
+
+TEST(Stress, AFilterThatNamesNoCaseIsAnErrorNamingItAndTheGroups) {
+  const std::string error = testing::error_of<ConfigError>([] {
+    select_stress_cases({"stacks", "stakcs"}, 0.01, "--valid-stress");
+  });
+  EXPECT_NE(error.find("--valid-stress 'stakcs': no such case"), std::string::npos) << error;
+  EXPECT_NE(error.find("the groups are canonical, rest, stacks"), std::string::npos) << error;
+}
+
+// The cases run side by side give what each gives run alone, in the cases' order: Bullet, the
+// network alone and the world (its Eigen setting left alone), pose for pose.
+TEST(Stress, CasesRunSideBySideAsEachAlone) {
+  auto model = std::make_shared<const Model>(
+      load_model(std::string(FIGNET_SOURCE_DIR) + "/models/movi-a-small.h5"));
+  const std::vector<Simulator> sims = stress_simulators({{"movi-a-small", model}}, 1, 0);
+  const std::vector<StressCase> cases =
+      select_stress_cases({"stack of 2", "one cube at rest", "canonical: cube dropped"}, 0.02);
+  ASSERT_EQ(cases.size(), 4u);
+  const auto together = run_stress_cases(cases, sims, 3);
+  ASSERT_EQ(together.size(), cases.size());
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const std::vector<StressRun> alone = run_stress_case(cases[i], sims);
+    ASSERT_EQ(together[i].size(), alone.size()) << cases[i].name;
+    for (size_t s = 0; s < alone.size(); ++s) {
+      const Trajectory& a = alone[s].trajectory;
+      const Trajectory& b = together[i][s].trajectory;
+      ASSERT_EQ(a.objects.size(), b.objects.size());
+      for (size_t o = 0; o < a.objects.size(); ++o) {
+        for (size_t f = 0; f < a.objects[o].poses.size(); ++f) {
+          EXPECT_EQ(a.objects[o].poses[f].position, b.objects[o].poses[f].position)
+              << cases[i].name << ", " << alone[s].simulator << ", frame " << f;
+        }
+      }
+      EXPECT_EQ(together[i][s].drift, alone[s].drift) << cases[i].name;
+    }
+  }
 }
 
 }  // namespace

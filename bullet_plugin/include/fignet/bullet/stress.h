@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "fignet/bullet/bullet_simulation.h"
@@ -25,6 +26,14 @@ struct StressCase {
 // Every case, each `frames` long where the issue fixes no length (0: the cases' own lengths).
 // `scale_frames` < 1 shortens the long cases for quick runs and tests.
 std::vector<StressCase> stress_cases(double scale_frames = 1.0);
+
+// The cases named by `filters`, in the suite's order: a case is kept when its name contains one
+// of them or its group is one (every case for no filter). A filter that matches nothing is a
+// ConfigError naming it and the `option` it came from, so a misspelt case fails before a long
+// run, not after.
+std::vector<StressCase> select_stress_cases(const std::vector<std::string>& filters,
+                                            double scale_frames = 1.0,
+                                            std::string_view option = "--case");
 
 struct StressRun {
   std::string simulator;
@@ -46,11 +55,20 @@ struct Simulator {
 
 // Native Bullet at 240 Hz and, per model, a FIGNet world stepping once per frame: the network
 // alone, then the world as users get it, both averaging over `turns` headings
-// (FIGNetWorldOptions::turns).
+// (FIGNetWorldOptions::turns). `world_threads` is each world's FIGNetWorldOptions::threads: 0
+// leaves Eigen's process-wide setting alone, as worlds run side by side must.
 std::vector<Simulator> stress_simulators(
-    const std::vector<std::pair<std::string, std::shared_ptr<const Model>>>& models, int turns = 1);
+    const std::vector<std::pair<std::string, std::shared_ptr<const Model>>>& models, int turns = 1,
+    int world_threads = 1);
 
 // Runs one case on each simulator (the first is the reference for `error`).
 std::vector<StressRun> run_stress_case(const StressCase& c, const std::vector<Simulator>& sims);
+
+// run_stress_case for every case, the cases shared among `threads` (the longest started first),
+// the results in the cases' order. The simulators' worlds should have world_threads 0 when
+// `threads` > 1; each run's milliseconds_per_frame then counts a core shared with the others.
+std::vector<std::vector<StressRun>> run_stress_cases(const std::vector<StressCase>& cases,
+                                                     const std::vector<Simulator>& sims,
+                                                     int threads);
 
 }  // namespace fignet::bullet
