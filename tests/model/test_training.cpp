@@ -491,6 +491,46 @@ TEST(Trainer, PushforwardTrainsOnTheNetworksOwnPrediction) {
   EXPECT_EQ(trainer.batch_pushed(), (std::vector<std::uint8_t>{0, 1}));
 }
 
+// With random_yaw a pushed scene is advanced unturned (the truth it advances by is unturned) and
+// turned after: it is the unturned run's pushed scene and targets turned by one angle.
+TEST(Trainer, APushedSceneIsTurnedAfterItsPush) {
+  const auto data = spinning_cubes(10);
+  const std::vector<SampleRef> samples = {{0, 6}, {0, 4}};
+  TrainerConfig pushing;
+  pushing.batch_size = 2;
+  pushing.pushforward_fraction = 1.0f;
+  ModelConfig config = noisy_model();
+  Trainer straight(config, pushing, data);
+  config.random_yaw = true;
+  Trainer turned(config, pushing, data);
+  straight.step_on(samples, 7);
+  turned.step_on(samples, 7);
+  ASSERT_EQ(turned.batch_pushed(), (std::vector<std::uint8_t>{1, 1}));
+  for (size_t b = 0; b < samples.size(); ++b) {
+    const Scene& unturned = straight.batch_scenes()[b];
+    const Scene& got = turned.batch_scenes()[b];
+    // The angle that takes the first node's offset from the turning axis to its turned one.
+    const Vec3 axis = unturned.floor ? Vec3(unturned.floor->center_x, unturned.floor->center_y, 0.0)
+                                     : Vec3::Zero();
+    const Vec3 from = unturned.objects[0].positions.row(0).transpose() - axis;
+    const Vec3 to = got.objects[0].positions.row(0).transpose() - axis;
+    const double angle =
+        std::atan2(from.x() * to.y() - from.y() * to.x(), from.x() * to.x() + from.y() * to.y());
+    ASSERT_GT(std::abs(angle), 1e-3) << "scene " << b << " was not turned";
+    Scene expected = unturned;
+    Points expected_targets = straight.batch_targets()[b];
+    turn_about_vertical(angle, expected, expected_targets);
+    for (size_t o = 0; o < got.objects.size(); ++o) {
+      EXPECT_LT((got.objects[o].positions - expected.objects[o].positions).cwiseAbs().maxCoeff(),
+                1e-9)
+          << "scene " << b << ", object " << o;
+      EXPECT_LT((got.objects[o].centers - expected.objects[o].centers).cwiseAbs().maxCoeff(), 1e-9)
+          << "scene " << b << ", object " << o;
+    }
+    EXPECT_LT((turned.batch_targets()[b] - expected_targets).cwiseAbs().maxCoeff(), 1e-9) << b;
+  }
+}
+
 // Pushing a share of the steps: chosen per step from the step's draw, the other steps unchanged
 // (the same scenes and targets as a run without it), and the statistics warm-up never pushed.
 TEST(Trainer, PushforwardFractionPushesItsShareOfStepsAndLeavesTheOthersAsTheyWere) {
