@@ -491,6 +491,49 @@ TEST(Trainer, PushforwardTrainsOnTheNetworksOwnPrediction) {
   EXPECT_EQ(trainer.batch_pushed(), (std::vector<std::uint8_t>{0, 1}));
 }
 
+// pushforward_skips_rest: in a pushed scene the body at rest in the data is advanced to its true
+// frame and the flying one to the network's prediction, as advance_to_predicted makes them from
+// the scene drawn a frame early (the rest flags come from the skip alone: rest weight 1).
+TEST(Trainer, PushforwardSkipsRestAdvancesRestingBodiesToTheTruth) {
+  const auto data = flying_and_resting_cubes(10);
+  const int h = noisy_model().graph.history;
+  const std::vector<SampleRef> samples = {{0, 6}};
+  TrainerConfig pushing;
+  pushing.batch_size = 1;
+  pushing.rest_loss_weight = 1.0f;
+  pushing.pushforward_fraction = 1.0f;
+  TrainerConfig skipping = pushing;
+  skipping.pushforward_skips_rest = true;
+  Trainer all(noisy_model(), pushing, data), skip(noisy_model(), skipping, data);
+  const std::shared_ptr<const Model> before = skip.current_model();
+  all.step_on(samples, 7);
+  skip.step_on(samples, 7);
+  ASSERT_EQ(skip.batch_pushed(), std::vector<std::uint8_t>{1});
+  // The oracle: the same draw a frame early, predicted, the resting cube put back on the truth.
+  Trainer plain(noisy_model(), {}, data);
+  plain.step_on({{0, 5}}, 7);
+  ModelPredictor predictor(before, PredictionOptions{.threads = 1, .fit_masses = false});
+  Scene expected = plain.batch_scenes()[0];
+  Points expected_targets = plain.batch_targets()[0];
+  std::vector<Pose> next;
+  StepWorkspace workspace;
+  predict_next_poses(predictor, expected, next, workspace);
+  next[1] = data[0].objects[1].poses[6];
+  advance_to_predicted(data[0], 6, h, next, 0.0, expected, expected_targets);
+  const Scene& got = skip.batch_scenes()[0];
+  for (size_t o = 0; o < 2; ++o) {
+    EXPECT_LT((got.objects[o].positions - expected.objects[o].positions).cwiseAbs().maxCoeff(),
+              1e-6)
+        << "object " << o;
+  }
+  EXPECT_LT((skip.batch_targets()[0] - expected_targets).cwiseAbs().maxCoeff(), 1e-6);
+  // The flying cube is pushed alike either way; the resting one only without the skip moves
+  // off the truth.
+  const Scene& pushed = all.batch_scenes()[0];
+  EXPECT_EQ(got.objects[0].positions, pushed.objects[0].positions);
+  EXPECT_GT((pushed.objects[1].positions - got.objects[1].positions).cwiseAbs().maxCoeff(), 1e-7);
+}
+
 // With random_yaw a pushed scene is advanced unturned (the truth it advances by is unturned) and
 // turned after: it is the unturned run's pushed scene and targets turned by one angle.
 TEST(Trainer, APushedSceneIsTurnedAfterItsPush) {

@@ -139,7 +139,7 @@ void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64
   const int scenes = static_cast<int>(samples.size());
   batch.scenes.resize(scenes);
   batch.scene_targets.resize(scenes);
-  if (weighs_rest()) batch.scene_resting.resize(scenes);
+  if (flags_rest()) batch.scene_resting.resize(scenes);
   // One noise seed per scene, drawn in scene order: the noise does not depend on the threads.
   batch.scene_seeds.resize(scenes);
   for (std::uint64_t& seed : batch.scene_seeds) seed = noise();
@@ -194,7 +194,7 @@ void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64
         if (!pushed)
           turn_about_vertical(batch.scene_yaw[b], batch.scenes[b], batch.scene_targets[b]);
       }
-      if (weighs_rest()) {
+      if (flags_rest()) {
         if (gap > 0.0) {
           // Every dynamic body is still, in the air.
           batch.scene_resting[b].assign(trajectory.objects.size(), 1);
@@ -270,6 +270,12 @@ void Trainer::push_forward_current() {
           pushforward_accelerations_.middleRows(first_node, rows).cast<double>();
       integrate_next_poses(scene, next, workspace);
       const SampleRef& sample = batch.samples[b];
+      if (trainer_config_.pushforward_skips_rest) {
+        const TrajectoryObject* truth = data_[sample.trajectory].objects.data();
+        for (size_t o = 0; o < next.size(); ++o) {
+          if (batch.scene_resting[b][o]) next[o] = truth[o].poses[sample.frame];
+        }
+      }
       advance_to_predicted(data_[sample.trajectory], sample.frame, h, next, correction, scene,
                            batch.scene_targets[b]);
       if (config_.random_yaw) {

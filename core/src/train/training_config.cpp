@@ -127,6 +127,8 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.weight_average; })},
       {"pushforward_fraction",
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.pushforward_fraction; })},
+      {"pushforward_skips_rest",
+       plain<bool>([](TrainingConfig & c) -> auto& { return c.trainer.pushforward_skips_rest; })},
       {"statistics_warmup",
        plain<int>([](TrainingConfig & c) -> auto& { return c.trainer.statistics_warmup; })},
       {"data_seed",

@@ -63,6 +63,11 @@ struct TrainerConfig {
   // history and still bodies in the air are not pushed. Costs one forward pass and one graph
   // build more per pushed step.
   float pushforward_fraction = 0.0f;
+  // In a pushed scene, bodies at rest in the data (the flag rest_loss_weight weighs) are
+  // advanced to their true frame, not to the prediction: the push teaches the network its own
+  // errors in motion and contact, not to correct a resting body's prediction by the loss's
+  // largest weight. false: every dynamic body is pushed.
+  bool pushforward_skips_rest = false;
 };
 
 // Everything besides the model that makes training continue exactly where it stopped: the
@@ -221,6 +226,8 @@ class Trainer {
   // over processes.
   double loss_and_gradient(bool with_gradient, bool reduce);
   bool weighs_rest() const { return trainer_config_.rest_loss_weight != 1.0f; }
+  // Whose samples carry the rest flags: those weighed in the loss or kept out of the push.
+  bool flags_rest() const { return weighs_rest() || trainer_config_.pushforward_skips_rest; }
   // Scales grads_ to trainer_config_.gradient_clip when longer.
   void clip_gradient();
   // averaged_params_ ← d·averaged_params_ + (1 − d)·params_, d = weight_average.
