@@ -1168,12 +1168,7 @@ void FIGNetDynamicsWorld::internalSingleStepSimulation(btScalar time_step) {
   }
   impl.stats.unfamiliar_floor =
       networked > 0 && impl.scene.floor && !familiar_floor(*impl.scene.floor, impl.model_config);
-  impl.stats.mesh_nodes = 0;
-  if (networked > 0) {
-    for (const SceneObject& object : impl.scene.objects) {
-      impl.stats.mesh_nodes += object.mesh->num_vertices();
-    }
-  }
+  impl.stats.mesh_nodes = networked > 0 ? static_cast<int>(impl.scene.num_nodes()) : 0;
   if (m_internalTickCallback) (*m_internalTickCallback)(this, time_step);
 }
 

@@ -58,4 +58,10 @@ void turn_about_vertical(double angle, Scene& scene) {
   }
 }
 
+Eigen::Index Scene::num_nodes() const {
+  Eigen::Index nodes = 0;
+  for (const SceneObject& object : objects) nodes += object.mesh->num_vertices();
+  return nodes;
+}
+
 }  // namespace fignet

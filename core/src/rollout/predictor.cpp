@@ -10,16 +10,6 @@
 
 namespace fignet {
 
-namespace {
-
-Eigen::Index count_nodes(const Scene& scene) {
-  Eigen::Index n = 0;
-  for (const SceneObject& object : scene.objects) n += object.mesh->num_vertices();
-  return n;
-}
-
-}  // namespace
-
 bool familiar_material(const StaticProperties& body, const ModelConfig& config) {
   return config.friction.holds(body.friction) && config.restitution.holds(body.restitution);
 }
@@ -114,14 +104,14 @@ void ModelPredictor::run_network(const Scene& scene, Points& accelerations) {
       model_->parameters().data(), model_->normalizers(), graph_, workspace_, false);
   Eigen::setNbThreads(previous);
   // The scene's objects come first in the graph; a mesh floor's nodes follow and are dropped.
-  const Eigen::Index n = count_nodes(scene);
+  const Eigen::Index n = scene.num_nodes();
   denormalized_.resize(n, 3);
   model_->normalizers().target.denormalize(normalized.topRows(n), denormalized_);
   accelerations = denormalized_.cast<double>();
 }
 
 void GravityPredictor::predict(const Scene& scene, Points& accelerations) {
-  accelerations.resize(count_nodes(scene), 3);
+  accelerations.resize(scene.num_nodes(), 3);
   accelerations.rowwise() = step_acceleration_.transpose();
 }
 

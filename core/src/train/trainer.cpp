@@ -263,11 +263,9 @@ void Trainer::push_forward_current() {
     for (int b = begin; b < end; ++b) {
       if (!batch.scene_pushed[b]) continue;
       Scene& scene = batch.scenes[b];
-      Eigen::Index rows = 0;
-      for (const SceneObject& object : scene.objects) rows += object.mesh->num_vertices();
       const int first_node = graph.object_first_node[graph.scene_first_object[b]];
       workspace.accelerations =
-          pushforward_accelerations_.middleRows(first_node, rows).cast<double>();
+          pushforward_accelerations_.middleRows(first_node, scene.num_nodes()).cast<double>();
       integrate_next_poses(scene, next, workspace);
       const SampleRef& sample = batch.samples[b];
       if (trainer_config_.pushforward_skips_rest) {

@@ -67,9 +67,7 @@ Points add_history_noise(SceneObject& object, int history, double noise_std, Noi
 // each object's block of them.
 template <typename Fill>
 void fill_target_rows(Scene& scene, Points& targets, const Fill& fill) {
-  Eigen::Index rows = 0;
-  for (const SceneObject& object : scene.objects) rows += object.mesh->num_vertices();
-  targets.setZero(rows, 3);
+  targets.setZero(scene.num_nodes(), 3);
   Eigen::Index row = 0;
   for (size_t o = 0; o < scene.objects.size(); ++o) {
     const Eigen::Index v = scene.objects[o].mesh->num_vertices();

@@ -67,6 +67,10 @@ struct Floor {
 struct Scene {
   std::vector<SceneObject> objects;
   std::optional<Floor> floor;  // used when GraphConfig::floor is kMesh or kImplicit
+
+  // The objects' mesh nodes (vertices) together: the rows of a per-node array of the scene (its
+  // accelerations), which a mesh floor's nodes never join.
+  Eigen::Index num_nodes() const;
 };
 
 // Turns every object's positions, centres and kinematic next poses by `angle` radians about the
