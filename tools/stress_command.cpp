@@ -152,7 +152,7 @@ void add_stress_command(CLI::App& app) {
   auto args = std::make_shared<StressArgs>();
   auto* cmd = app.add_subcommand(
       "stress",
-      "Run scenes at the extremes (rest, stacks, sizes, densities, fast impacts, 1 km away, "
+      "Run scenes at the extremes (rest, piles, stacks, sizes, densities, fast impacts, 1 km away, "
       "long rollouts, odd meshes) in native Bullet and FIGNet, and report what goes wrong");
   cmd->add_option("--model", args->models, "Model file (repeatable; none: native Bullet only)")
       ->check(CLI::ExistingFile);

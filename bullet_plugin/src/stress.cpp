@@ -7,7 +7,9 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <numbers>
 #include <numeric>
+#include <random>
 
 #include "fignet/bullet/fignet_dynamics_world.h"
 #include "fignet/error.h"
@@ -55,16 +57,27 @@ BodySpec odd_body(const TriangleMesh& mesh, const Vec3& at) {
   return body;
 }
 
-// Bodies dropped in a column and left to settle by native Bullet, returned at rest.
-SceneSpec settled_pile(int count, int frames) {
+// Bodies dropped in a column and left to settle by native Bullet, returned at rest. Arrangement
+// 0 is the suite's pile; others move each body's drop point by up to 0.2 m, turn it about the
+// vertical and draw its shape, all from the arrangement's own generator: another heap of the
+// same kind, since one rollout of a chaotic pile says little about a model.
+SceneSpec settled_pile(int count, int frames, std::uint64_t arrangement = 0) {
   SceneSpec drop = empty_scene(240);
   const auto& names = movi_shape_names();
+  std::mt19937_64 rng(arrangement);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int i = 0; i < count; ++i) {
-    BodySpec body =
-        make_body(make_movi_shape(names[static_cast<size_t>(i % 3)]), kDensity, 0.5, 0.3);
+    const size_t shape = arrangement == 0 ? static_cast<size_t>(i % 3)
+                                          : std::min<size_t>(2, static_cast<size_t>(3 * unit(rng)));
+    BodySpec body = make_body(make_movi_shape(names[shape]), kDensity, 0.5, 0.3);
     const int per_layer = 4;
     const double x = (i % per_layer % 2) * 1.3 - 0.65, y = (i % per_layer / 2) * 1.3 - 0.65;
     body.pose.position = Vec3(x + 0.05 * (i % 5), y, 1.0 + 1.2 * (i / per_layer));
+    if (arrangement != 0) {
+      body.pose.position += Vec3(0.4 * unit(rng) - 0.2, 0.4 * unit(rng) - 0.2, 0.0);
+      body.pose.orientation =
+          Eigen::Quaterniond(Eigen::AngleAxisd(2.0 * std::numbers::pi * unit(rng), Vec3::UnitZ()));
+    }
     drop.bodies.push_back(body);
   }
   BulletSimulation settle(drop);
@@ -125,6 +138,11 @@ std::vector<StressCase> stress_cases(double scale_frames) {
   cases.push_back(make_case("MOVi cube at rest", "rest", movi_rest, true));
   cases.push_back(
       make_case("10-object pile at rest", "rest", settled_pile(10, frames(2000)), true, false));
+  // The pile again in three other arrangements (not in "rest": a quick check stays quick).
+  for (std::uint64_t arrangement = 1; arrangement <= 3; ++arrangement) {
+    cases.push_back(make_case(fmt::format("10-object pile, arrangement {}", arrangement), "piles",
+                              settled_pile(10, frames(2000), arrangement), true, false));
+  }
   // Stacks of 2–5 cubes left standing.
   for (int n = 2; n <= 5; ++n) {
     SceneSpec stack = empty_scene(frames(480));

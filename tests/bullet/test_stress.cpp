@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 
 #include "../error_text.h"
 #include "fignet/bullet/stress.h"
@@ -86,6 +87,39 @@ TEST(Stress, TheMoviCubeStartsWhereBulletRestsIt) {
   FAIL() << "no case named 'MOVi cube at rest'";
 }
 
+// The pile's other arrangements are other heaps of the same kind: ten bodies each, one or more
+// left resting on others after settling (their lowest point well above the floor; 1-4 in these
+// four), no two arrangements alike.
+TEST(Stress, PileArrangementsAreDifferentHeaps) {
+  std::vector<StressCase> piles;
+  for (StressCase& c : stress_cases(0.01)) {
+    if (c.name == "10-object pile at rest" || c.group == "piles") piles.push_back(std::move(c));
+  }
+  ASSERT_EQ(piles.size(), 4u);
+  for (size_t i = 0; i < piles.size(); ++i) {
+    const SceneSpec& scene = piles[i].scene;
+    ASSERT_EQ(scene.bodies.size(), 10u) << piles[i].name;
+    EXPECT_TRUE(piles[i].at_rest);
+    int on_others = 0;
+    for (const BodySpec& body : scene.bodies) {
+      double lowest = std::numeric_limits<double>::infinity();
+      for (Eigen::Index v = 0; v < body.mesh->num_vertices(); ++v) {
+        lowest = std::min(lowest, body.pose.apply(body.mesh->vertices().row(v).transpose()).z());
+      }
+      if (lowest > scene.floor->height + 0.1) ++on_others;
+    }
+    EXPECT_GE(on_others, 1) << piles[i].name;
+    for (size_t j = 0; j < i; ++j) {
+      double apart = 0.0;
+      for (size_t b = 0; b < scene.bodies.size(); ++b) {
+        apart = std::max(
+            apart, (scene.bodies[b].pose.position - piles[j].scene.bodies[b].pose.position).norm());
+      }
+      EXPECT_GT(apart, 0.1) << piles[i].name << " against " << piles[j].name;
+    }
+  }
+}
+
 std::vector<std::string> names(const std::vector<StressCase>& cases) {
   std::vector<std::string> out;
   for (const StressCase& c : cases) out.push_back(c.name);
@@ -115,7 +149,8 @@ TEST(Stress, AFilterThatNamesNoCaseIsAnErrorNamingItAndTheGroups) {
     select_stress_cases({"stacks", "stakcs"}, 0.01, "--valid-stress");
   });
   EXPECT_NE(error.find("--valid-stress 'stakcs': no such case"), std::string::npos) << error;
-  EXPECT_NE(error.find("the groups are canonical, rest, stacks"), std::string::npos) << error;
+  EXPECT_NE(error.find("the groups are canonical, rest, piles, stacks"), std::string::npos)
+      << error;
 }
 
 // The cases run side by side give what each gives run alone, in the cases' order: Bullet, the
