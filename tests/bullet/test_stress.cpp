@@ -3,10 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <limits>
 
 #include "../error_text.h"
 #include "fignet/bullet/stress.h"
+#include "fignet/graph/scene.h"
 #include "fignet/io/model_file.h"
 
 namespace fignet::bullet {
@@ -103,10 +103,7 @@ TEST(Stress, PileArrangementsAreDifferentHeaps) {
     ASSERT_EQ(scene.bodies.size(), 10u) << piles[i].name;
     EXPECT_TRUE(piles[i].at_rest);
     for (const BodySpec& body : scene.bodies) {
-      double lowest = std::numeric_limits<double>::infinity();
-      for (Eigen::Index v = 0; v < body.mesh->num_vertices(); ++v) {
-        lowest = std::min(lowest, body.pose.apply(body.mesh->vertices().row(v).transpose()).z());
-      }
+      const double lowest = posed_vertices(*body.mesh, body.pose).col(2).minCoeff();
       if (lowest > scene.floor->height + 0.1) ++on_others;
     }
     for (size_t j = 0; j < i; ++j) {
