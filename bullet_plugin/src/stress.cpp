@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <functional>
 #include <numbers>
 #include <numeric>
 #include <random>
@@ -91,16 +92,29 @@ SceneSpec settled_pile(int count, int frames, std::uint64_t arrangement = 0) {
   return rest;
 }
 
-StressCase make_case(std::string name, std::string group, SceneSpec scene, bool at_rest,
-                     bool compare = true) {
-  return {std::move(name), std::move(group), std::move(scene), at_rest, compare, Vec3::Zero()};
+// A case before its scene is built: piles are settled by Bullet (a second each, the 100-object one
+// many), so a selection builds only the scenes it keeps.
+struct CaseRecipe {
+  StressCase header;  // everything but the scene
+  std::function<SceneSpec()> build;
+};
+
+CaseRecipe make_case(std::string name, std::string group, std::function<SceneSpec()> build,
+                     bool at_rest, bool compare = true) {
+  return {{std::move(name), std::move(group), {}, at_rest, compare, Vec3::Zero()},
+          std::move(build)};
 }
 
-}  // namespace
+CaseRecipe make_case(std::string name, std::string group, SceneSpec scene, bool at_rest,
+                     bool compare = true) {
+  return make_case(
+      std::move(name), std::move(group), [scene = std::move(scene)] { return scene; }, at_rest,
+      compare);
+}
 
-std::vector<StressCase> stress_cases(double scale_frames) {
+std::vector<CaseRecipe> case_recipes(double scale_frames) {
   const auto frames = [&](int n) { return std::max(8, static_cast<int>(n * scale_frames)); };
-  std::vector<StressCase> cases;
+  std::vector<CaseRecipe> cases;
   // Canonical scenes (issue 13), each one behaviour a model must get right; with "one cube at
   // rest" and "stack of 2 cubes" below they are the quick check of any model (--case canonical,
   // --case rest, --case "stack of 2").
@@ -136,12 +150,16 @@ std::vector<StressCase> stress_cases(double scale_frames) {
   movi_rest.bodies.push_back(make_body(make_box(Vec3::Constant(0.7)), 2.7, 0.4, 0.3));
   movi_rest.bodies.back().pose.position = Vec3(0, 0, 0.7 + movi_rest.collision_margin);
   cases.push_back(make_case("MOVi cube at rest", "rest", movi_rest, true));
-  cases.push_back(
-      make_case("10-object pile at rest", "rest", settled_pile(10, frames(2000)), true, false));
+  const auto pile = [&](int count, int length, std::uint64_t arrangement = 0) {
+    return [count, length = frames(length), arrangement] {
+      return settled_pile(count, length, arrangement);
+    };
+  };
+  cases.push_back(make_case("10-object pile at rest", "rest", pile(10, 2000), true, false));
   // The pile again in three other arrangements (not in "rest": a quick check stays quick).
   for (std::uint64_t arrangement = 1; arrangement <= 3; ++arrangement) {
     cases.push_back(make_case(fmt::format("10-object pile, arrangement {}", arrangement), "piles",
-                              settled_pile(10, frames(2000), arrangement), true, false));
+                              pile(10, 2000, arrangement), true, false));
   }
   // Stacks of 2–5 cubes left standing.
   for (int n = 2; n <= 5; ++n) {
@@ -198,15 +216,14 @@ std::vector<StressCase> stress_cases(double scale_frames) {
     toss.bodies.push_back(box(Vec3::Constant(0.5), Vec3(offset, offset, 0.5)));
     toss.bodies.push_back(box(Vec3::Constant(0.4), Vec3(offset + 0.2, offset, 3)));
     toss.bodies.back().linear_velocity = Vec3(0.5, 0, -2);
-    StressCase c = make_case(offset == 0 ? "tossed pair at the origin" : "tossed pair 1 km away",
+    CaseRecipe c = make_case(offset == 0 ? "tossed pair at the origin" : "tossed pair 1 km away",
                              "far", toss, false);
-    c.shift = Vec3(offset, offset, 0);
+    c.header.shift = Vec3(offset, offset, 0);
     cases.push_back(c);
   }
   // Long rollouts: 10 objects for 5000 steps, a pile of 100.
-  cases.push_back(
-      make_case("10-object pile, 5000 steps", "long", settled_pile(10, frames(5000)), true, false));
-  cases.push_back(make_case("100-object pile", "long", settled_pile(100, frames(96)), true, false));
+  cases.push_back(make_case("10-object pile, 5000 steps", "long", pile(10, 5000), true, false));
+  cases.push_back(make_case("100-object pile", "long", pile(100, 96), true, false));
   // Odd meshes dropped on the floor: a sliver, one triangle, an open box, a sphere coarse and
   // fine, coincident vertices.
   const auto mesh_case = [&](const TriangleMesh& mesh, const std::string& name) {
@@ -235,20 +252,43 @@ std::vector<StressCase> stress_cases(double scale_frames) {
   return cases;
 }
 
+StressCase build(const CaseRecipe& recipe) {
+  StressCase c = recipe.header;
+  c.scene = recipe.build();
+  return c;
+}
+
+}  // namespace
+
+std::vector<StressCase> stress_cases(double scale_frames) {
+  return stress_cases(scale_frames, [](std::string_view, std::string_view) { return true; });
+}
+
+std::vector<StressCase> stress_cases(
+    double scale_frames, const std::function<bool(std::string_view, std::string_view)>& keep) {
+  std::vector<StressCase> cases;
+  for (const CaseRecipe& recipe : case_recipes(scale_frames)) {
+    if (keep(recipe.header.name, recipe.header.group)) cases.push_back(build(recipe));
+  }
+  return cases;
+}
+
 std::vector<StressCase> select_stress_cases(const std::vector<std::string>& filters,
                                             double scale_frames, std::string_view option) {
-  std::vector<StressCase> cases = stress_cases(scale_frames);
-  if (filters.empty()) return cases;
-  const auto matches = [](const StressCase& c, const std::string& filter) {
-    return c.name.find(filter) != std::string::npos || c.group == filter;
+  const auto matches = [](std::string_view name, std::string_view group,
+                          const std::string& filter) {
+    return name.find(filter) != std::string_view::npos || group == filter;
   };
+  // Every filter must name a case, checked on the recipes before any pile is settled.
+  const std::vector<CaseRecipe> recipes = case_recipes(scale_frames);
   for (const std::string& filter : filters) {
-    if (std::none_of(cases.begin(), cases.end(),
-                     [&](const StressCase& c) { return matches(c, filter); })) {
+    if (std::none_of(recipes.begin(), recipes.end(), [&](const CaseRecipe& r) {
+          return matches(r.header.name, r.header.group, filter);
+        })) {
       std::vector<std::string> groups;
-      for (const StressCase& c : cases) {
-        if (std::find(groups.begin(), groups.end(), c.group) == groups.end()) {
-          groups.push_back(c.group);
+      for (const CaseRecipe& r : recipes) {
+        if (std::find(groups.begin(), groups.end(), r.header.group) == groups.end()) {
+          groups.push_back(r.header.group);
         }
       }
       throw ConfigError(
@@ -256,10 +296,14 @@ std::vector<StressCase> select_stress_cases(const std::vector<std::string>& filt
                       option, filter, fmt::join(groups, ", ")));
     }
   }
-  std::erase_if(cases, [&](const StressCase& c) {
-    return std::none_of(filters.begin(), filters.end(),
-                        [&](const std::string& filter) { return matches(c, filter); });
-  });
+  std::vector<StressCase> cases;
+  for (const CaseRecipe& recipe : recipes) {
+    if (filters.empty() || std::any_of(filters.begin(), filters.end(), [&](const std::string& f) {
+          return matches(recipe.header.name, recipe.header.group, f);
+        })) {
+      cases.push_back(build(recipe));
+    }
+  }
   return cases;
 }
 
