@@ -252,10 +252,17 @@ std::vector<CaseRecipe> case_recipes(double scale_frames) {
   return cases;
 }
 
-StressCase build(const CaseRecipe& recipe) {
-  StressCase c = recipe.header;
-  c.scene = recipe.build();
-  return c;
+// The kept recipes' cases, each scene built here and only here.
+std::vector<StressCase> build_kept(
+    const std::vector<CaseRecipe>& recipes,
+    const std::function<bool(std::string_view, std::string_view)>& keep) {
+  std::vector<StressCase> cases;
+  for (const CaseRecipe& recipe : recipes) {
+    if (!keep(recipe.header.name, recipe.header.group)) continue;
+    cases.push_back(recipe.header);
+    cases.back().scene = recipe.build();
+  }
+  return cases;
 }
 
 }  // namespace
@@ -266,11 +273,7 @@ std::vector<StressCase> stress_cases(double scale_frames) {
 
 std::vector<StressCase> stress_cases(
     double scale_frames, const std::function<bool(std::string_view, std::string_view)>& keep) {
-  std::vector<StressCase> cases;
-  for (const CaseRecipe& recipe : case_recipes(scale_frames)) {
-    if (keep(recipe.header.name, recipe.header.group)) cases.push_back(build(recipe));
-  }
-  return cases;
+  return build_kept(case_recipes(scale_frames), keep);
 }
 
 std::vector<StressCase> select_stress_cases(const std::vector<std::string>& filters,
@@ -296,15 +299,10 @@ std::vector<StressCase> select_stress_cases(const std::vector<std::string>& filt
                       option, filter, fmt::join(groups, ", ")));
     }
   }
-  std::vector<StressCase> cases;
-  for (const CaseRecipe& recipe : recipes) {
-    if (filters.empty() || std::any_of(filters.begin(), filters.end(), [&](const std::string& f) {
-          return matches(recipe.header.name, recipe.header.group, f);
-        })) {
-      cases.push_back(build(recipe));
-    }
-  }
-  return cases;
+  return build_kept(recipes, [&](std::string_view name, std::string_view group) {
+    return filters.empty() || std::any_of(filters.begin(), filters.end(),
+                                          [&](const auto& f) { return matches(name, group, f); });
+  });
 }
 
 std::vector<Simulator> stress_simulators(

@@ -21,7 +21,7 @@ std::vector<Simulator> shipped_model_world() {
 }
 
 // Every case, shortened to a few frames; the 100-object pile, which costs seconds per frame, is
-// left out (and not built) (the 20,000-vertex sphere is in: the node budget makes it cheap).
+// left out and not built (the 20,000-vertex sphere is in: the node budget makes it cheap).
 TEST(Stress, EveryCaseStaysFinite) {
   const auto sims = shipped_model_world();
   const auto all_but_the_100_pile = [](std::string_view name, std::string_view) {
