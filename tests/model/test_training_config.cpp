@@ -51,12 +51,13 @@ TEST(TrainingConfig, PresetsCarryTheRecipeAndTheDefaultsStayTheOldOne) {
     TrainingConfig old;
     old.model = ModelConfig::preset_named(name);
     old.trainer.adam.decay_steps = old.steps;
-    EXPECT_EQ(old.differing_fields(preset),
-              (std::vector<std::string>{"static_internal_edges", "log_mass", "velocity_log_scale",
-                                        "noise", "normalizer_max_accumulations", "batch_size",
-                                        "learning_rate_start", "learning_rate_end", "gradient_clip",
-                                        "huber_delta", "rest_loss_weight", "still_air_fraction",
-                                        "weight_average", "statistics_warmup"}))
+    EXPECT_EQ(
+        old.differing_fields(preset),
+        (std::vector<std::string>{"static_internal_edges", "log_mass", "velocity_log_scale",
+                                  "noise", "normalizer_max_accumulations", "batch_size",
+                                  "learning_rate_start", "learning_rate_end", "gradient_clip",
+                                  "huber_delta", "rest_loss_weight", "still_air_fraction",
+                                  "weight_average", "pushforward_fraction", "statistics_warmup"}))
         << name;
     EXPECT_EQ(preset.field_text("noise"), "\"rigid\"");
     EXPECT_EQ(preset.trainer.batch_size, 8);
@@ -66,6 +67,8 @@ TEST(TrainingConfig, PresetsCarryTheRecipeAndTheDefaultsStayTheOldOne) {
     EXPECT_EQ(preset.trainer.still_air_fraction, 0.1f);
     EXPECT_EQ(preset.trainer.adam.learning_rate_start, 5e-4f);
     EXPECT_EQ(preset.trainer.adam.learning_rate_end, 5e-5f);
+    EXPECT_EQ(preset.trainer.pushforward_fraction, 0.5f);
+    EXPECT_EQ(old.trainer.pushforward_fraction, 0.0f);
     EXPECT_EQ(old.trainer.adam.learning_rate_start, 1e-3f);
     EXPECT_EQ(old.trainer.still_air_fraction, 0.0f);
     EXPECT_EQ(old.trainer.batch_size, 4);
