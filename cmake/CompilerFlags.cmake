@@ -16,4 +16,7 @@ if(CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64")
   endif()
 endif()
 set(CMAKE_CXX_FLAGS_RELEASE "-O3 -DNDEBUG")
-set(CMAKE_CXX_FLAGS_RELWITHDEBINFO "-O3 -g -DNDEBUG")
+# RelWithDebInfo is the sanitizer preset's build type. -O2 with line tables only (-g1) compiled
+# three of the heaviest sources under ASan + UBSan in 0.48-0.53 of the time -O3 -g took (Zen 3,
+# 2026-11-29), and -O2 runs as fast; backtraces keep their files and lines.
+set(CMAKE_CXX_FLAGS_RELWITHDEBINFO "-O2 -g1 -DNDEBUG")
