@@ -167,7 +167,7 @@ def test_a_fine_mesh_enters_the_graph_within_the_node_budget(model):
 
 def test_turn_averaging_cancels_the_models_sideways_push_at_rest(model):
     # A model pushes a resting body sideways by a bias of its own; predictions averaged with the
-    # scene turned half a turn cancel the part of it that turns with the scene
+    # scene turned half a turn cancel the part of it whose direction does not turn with the scene
     # (FIGNetWorldOptions::turns; the exact cancellation of a constant bias is ModelPredictor's
     # C++ test). The body is the data's own (a 1.4 m metal cube of 7.4 kg on Kubric's floor,
     # resting 5 mm up where Bullet's margin rests it): outside the data's materials a model's push
