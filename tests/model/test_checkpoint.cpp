@@ -49,6 +49,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   trainer_config.still_air_fraction = 0.5f;
   trainer_config.pushforward_fraction = 0.5f;
   trainer_config.pushforward_skips_rest = true;
+  trainer_config.pushforward_steps = 2;
   Trainer uninterrupted(tiny_model(), trainer_config, data);
   uninterrupted.run(10, nullptr);
 
@@ -64,6 +65,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   EXPECT_EQ(checkpoint.trainer_config.still_air_fraction, 0.5f);
   EXPECT_EQ(checkpoint.trainer_config.pushforward_fraction, 0.5f);
   EXPECT_TRUE(checkpoint.trainer_config.pushforward_skips_rest);
+  EXPECT_EQ(checkpoint.trainer_config.pushforward_steps, 2);
   Trainer resumed(checkpoint.model->config(), checkpoint.trainer_config, data,
                   checkpoint.model.get());
   resumed.restore(checkpoint.state);
@@ -88,6 +90,7 @@ TEST_F(Checkpoints, AFileWithoutLaterFieldsReadsWhatOlderRunsTrainedWith) {
   trainer_config.weight_average = 0.75f;
   trainer_config.pushforward_fraction = 0.5f;
   trainer_config.pushforward_skips_rest = true;
+  trainer_config.pushforward_steps = 3;
   const auto data = falling_cubes();
   Trainer trainer(tiny_model(), trainer_config, data);
   const fs::path path = dir_ / "run.ckpt.h5";
@@ -95,9 +98,10 @@ TEST_F(Checkpoints, AFileWithoutLaterFieldsReadsWhatOlderRunsTrainedWith) {
   {
     H5::H5File file(path.string(), H5F_ACC_RDWR);
     H5::Group training = file.openGroup("training");
-    for (const char* name : {"gradient_clip", "huber_delta", "statistics_warmup",
-                             "rest_loss_weight", "weight_average", "still_air_fraction",
-                             "pushforward_fraction", "pushforward_skips_rest", "planned_steps"}) {
+    for (const char* name :
+         {"gradient_clip", "huber_delta", "statistics_warmup", "rest_loss_weight", "weight_average",
+          "still_air_fraction", "pushforward_fraction", "pushforward_skips_rest",
+          "pushforward_steps", "planned_steps"}) {
       training.removeAttr(name);
     }
   }
@@ -111,6 +115,7 @@ TEST_F(Checkpoints, AFileWithoutLaterFieldsReadsWhatOlderRunsTrainedWith) {
   EXPECT_EQ(checkpoint.trainer_config.still_air_fraction, defaults.still_air_fraction);
   EXPECT_EQ(checkpoint.trainer_config.pushforward_fraction, defaults.pushforward_fraction);
   EXPECT_EQ(checkpoint.trainer_config.pushforward_skips_rest, defaults.pushforward_skips_rest);
+  EXPECT_EQ(checkpoint.trainer_config.pushforward_steps, defaults.pushforward_steps);
   EXPECT_EQ(checkpoint.planned_steps, 0);
 }
 

@@ -448,6 +448,18 @@ TEST(TrainingBatch, AdvancingToAWrongPredictionTeachesTheTrueVelocityFromIt) {
                ConfigError);
 }
 
+// The trainer's last batch's scene b and its target rows within float tolerance of an oracle's.
+void expect_batch_scene_near(const Trainer& trainer, size_t b, const Scene& expected,
+                             const Points& expected_targets) {
+  const Scene& got = trainer.batch_scenes()[b];
+  for (size_t o = 0; o < got.objects.size(); ++o) {
+    EXPECT_LT((got.objects[o].positions - expected.objects[o].positions).cwiseAbs().maxCoeff(),
+              1e-6)
+        << "scene " << b << ", object " << o;
+  }
+  EXPECT_LT((trainer.batch_targets()[b] - expected_targets).cwiseAbs().maxCoeff(), 1e-6) << b;
+}
+
 // A pushed step trains on the scene advanced to what the network itself predicts from the frame
 // before: the same as predicting that frame with a ModelPredictor of the trainer's model (the
 // inference path, apart from the trainer's) and advancing the sample to it.
@@ -473,13 +485,7 @@ TEST(Trainer, PushforwardTrainsOnTheNetworksOwnPrediction) {
     StepWorkspace workspace;
     predict_next_poses(predictor, expected, next, workspace);
     advance_to_predicted(data[0], samples[b].frame, h, next, 0.0, expected, expected_targets);
-    const Scene& got = trainer.batch_scenes()[b];
-    for (size_t o = 0; o < got.objects.size(); ++o) {
-      EXPECT_LT((got.objects[o].positions - expected.objects[o].positions).cwiseAbs().maxCoeff(),
-                1e-6)
-          << "scene " << b << ", object " << o;
-    }
-    EXPECT_LT((trainer.batch_targets()[b] - expected_targets).cwiseAbs().maxCoeff(), 1e-6) << b;
+    expect_batch_scene_near(trainer, b, expected, expected_targets);
   }
   // The prediction is not the truth: the pushed samples differ from their frames' own.
   plain.step_on(samples, 7);
@@ -489,6 +495,52 @@ TEST(Trainer, PushforwardTrainsOnTheNetworksOwnPrediction) {
   // The first frame with a history has no frame before it to push from.
   trainer.step_on({{0, h}, {0, 6}}, 7);
   EXPECT_EQ(trainer.batch_pushed(), (std::vector<std::uint8_t>{0, 1}));
+}
+
+// pushforward_steps: a pushed scene is drawn that many frames early (fewer where the first frame
+// with a history comes sooner) and rolled out by the network to its own frame, each step as
+// ModelPredictor predicts it and advance_to_predicted moves it on; a scene at the first frame
+// with a history is not pushed.
+TEST(Trainer, PushforwardStepsRollsAPushedSceneOutToItsFrame) {
+  const auto data = spinning_cubes(10);
+  const int h = noisy_model().graph.history;
+  const std::vector<SampleRef> samples = {{0, h + 3}, {0, h + 1}, {0, h}};
+  TrainerConfig pushing;
+  pushing.batch_size = 3;
+  pushing.pushforward_fraction = 1.0f;
+  pushing.pushforward_steps = 3;
+  Trainer trainer(noisy_model(), pushing, data);
+  const std::shared_ptr<const Model> before = trainer.current_model();
+  trainer.step_on(samples, 7);
+  ASSERT_EQ(trainer.batch_pushed(), (std::vector<std::uint8_t>{3, 1, 0}));
+  // The oracle: the same draw unpushed at the frames the pushed scenes start from (same noise
+  // seeds), then one prediction and advance per frame.
+  Trainer plain(noisy_model(), {}, data);
+  plain.step_on({{0, h}, {0, h}, {0, h}}, 7);
+  ModelPredictor predictor(before, PredictionOptions{.threads = 1, .fit_masses = false});
+  for (size_t b = 0; b < samples.size(); ++b) {
+    Scene expected = plain.batch_scenes()[b];
+    Points expected_targets = plain.batch_targets()[b];
+    for (int frame = h + 1; frame <= samples[b].frame; ++frame) {
+      std::vector<Pose> next;
+      StepWorkspace workspace;
+      predict_next_poses(predictor, expected, next, workspace);
+      advance_to_predicted(data[0], frame, h, next, 0.0, expected, expected_targets);
+    }
+    expect_batch_scene_near(trainer, b, expected, expected_targets);
+  }
+  // Three steps of the network's own error are not one: the first scene differs from a push of
+  // one frame.
+  pushing.pushforward_steps = 1;
+  Trainer one(noisy_model(), pushing, data);
+  one.step_on(samples, 7);
+  ASSERT_EQ(one.batch_pushed(), (std::vector<std::uint8_t>{1, 1, 0}));
+  EXPECT_GT((trainer.batch_targets()[0] - one.batch_targets()[0]).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_EQ(trainer.batch_targets()[1], one.batch_targets()[1]);
+  for (int steps : {0, kMaxPushforwardSteps + 1}) {
+    pushing.pushforward_steps = steps;
+    EXPECT_THROW(Trainer(noisy_model(), pushing, data), ConfigError) << steps;
+  }
 }
 
 // pushforward_skips_rest: in a pushed scene the body at rest in the data is advanced to its true

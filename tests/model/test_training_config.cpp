@@ -108,6 +108,9 @@ TEST(TrainingConfig, BadInputNamesTheField) {
             std::string::npos);
   config.model.friction = {};
   EXPECT_NO_THROW(config.validate());
+  config.apply_setting("pushforward_steps=9");
+  EXPECT_NE(error_of([&] { config.validate(); }).find("pushforward_steps = 9 (must be in 1..8"),
+            std::string::npos);
 }
 
 TEST(DataRange, WidensToHoldEachValueAndHoldsEverythingWhileUnknown) {

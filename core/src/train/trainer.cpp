@@ -86,6 +86,11 @@ Trainer::Trainer(const ModelConfig& config, const TrainerConfig& trainer_config,
     throw ConfigError(fmt::format("trainer: pushforward_fraction = {} (must be in [0, 1]; 0: none)",
                                   trainer_config.pushforward_fraction));
   }
+  if (trainer_config.pushforward_steps < 1 ||
+      trainer_config.pushforward_steps > kMaxPushforwardSteps) {
+    throw ConfigError(fmt::format("trainer: pushforward_steps = {} (must be in 1..{})",
+                                  trainer_config.pushforward_steps, kMaxPushforwardSteps));
+  }
   if (trainer_config.pushforward_fraction > 0.0f && config.graph.history < 1) {
     throw ConfigError(
         "trainer: pushforward_fraction > 0 needs history >= 1 (a velocity to push forward)");
@@ -174,15 +179,19 @@ void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64
                                                                 std::log(kStillAirGaps[1]))(still));
         }
       }
-      // A pushed scene starts a frame early; push_forward_current brings it to its own frame.
-      const bool pushed = pushes && gap == 0.0 && samples[b].frame >= h + 1;
-      batch.scene_pushed[b] = pushed ? 1 : 0;
+      // A pushed scene starts up to pushforward_steps frames early, no earlier than the first
+      // frame with a history; push_forward_current brings it to its own frame.
+      const int push_steps = pushes && gap == 0.0 ? std::clamp(samples[b].frame - h, 0,
+                                                               trainer_config_.pushforward_steps)
+                                                  : 0;
+      const bool pushed = push_steps > 0;
+      batch.scene_pushed[b] = static_cast<std::uint8_t>(push_steps);
       if (gap > 0.0) {
         make_still_sample_in_air(trajectory, samples[b].frame, h, gap, config_.noise_std,
                                  config_.noise, config_.noise_correction, rng, batch.scenes[b],
                                  batch.scene_targets[b]);
       } else {
-        make_noisy_sample(trajectory, samples[b].frame - (pushed ? 1 : 0), h, config_.noise_std,
+        make_noisy_sample(trajectory, samples[b].frame - push_steps, h, config_.noise_std,
                           config_.noise, config_.noise_correction, rng, batch.scenes[b],
                           batch.scene_targets[b]);
       }
@@ -241,47 +250,58 @@ void Trainer::build_graph(int threads, PreparedBatch& batch,
 
 void Trainer::push_forward_current() {
   PreparedBatch& batch = current();
-  if (std::none_of(batch.scene_pushed.begin(), batch.scene_pushed.end(),
-                   [](std::uint8_t pushed) { return pushed != 0; })) {
-    return;
-  }
+  const int rounds = batch.scene_pushed.empty()
+                         ? 0
+                         : *std::max_element(batch.scene_pushed.begin(), batch.scene_pushed.end());
+  if (rounds == 0) return;
   const auto start = std::chrono::steady_clock::now();
-  // The network's prediction for every scene of the batch as drawn (the pushed ones a frame
-  // early), with the parameters being optimised and no gradient.
-  const ConstMatrixView output =
-      backend_->forward(params_.data(), normalizers_, batch.graph, false);
-  pushforward_accelerations_.resize(output.rows(), 3);
-  normalizers_.target.denormalize(output, pushforward_accelerations_);
-  const Graph& graph = batch.graph;
   const int h = config_.graph.history;
   const double correction = config_.noise_correction;
-  // Each pushed scene advanced to its prediction, then turned when random_yaw; in parallel
-  // parts like the first build.
-  auto advance = [&](int begin, int end) {
-    StepWorkspace workspace;
-    std::vector<Pose> next;
-    for (int b = begin; b < end; ++b) {
-      if (!batch.scene_pushed[b]) continue;
-      Scene& scene = batch.scenes[b];
-      const int first_node = graph.object_first_node[graph.scene_first_object[b]];
-      workspace.accelerations =
-          pushforward_accelerations_.middleRows(first_node, scene.num_nodes()).cast<double>();
-      integrate_next_poses(scene, next, workspace);
-      const SampleRef& sample = batch.samples[b];
-      if (trainer_config_.pushforward_skips_rest) {
-        const TrajectoryObject* truth = data_[sample.trajectory].objects.data();
-        for (size_t o = 0; o < next.size(); ++o) {
-          if (batch.scene_resting[b][o]) next[o] = truth[o].poses[sample.frame];
+  // Each scene's first node in the batch graph, read before build_graph rewrites the graph
+  // (its first part is rebuilt in place while the other parts advance their scenes).
+  std::vector<int> scene_first_node(batch.scenes.size());
+  // Round r advances every scene pushed more than r frames by one, to the frame r + 1 after the
+  // one it was drawn at, so each reaches its own frame after its last round.
+  for (int round = 0; round < rounds; ++round) {
+    // The network's prediction for every scene of the batch as it stands, with the parameters
+    // being optimised and no gradient.
+    const ConstMatrixView output =
+        backend_->forward(params_.data(), normalizers_, batch.graph, false);
+    pushforward_accelerations_.resize(output.rows(), 3);
+    normalizers_.target.denormalize(output, pushforward_accelerations_);
+    for (size_t b = 0; b < scene_first_node.size(); ++b) {
+      scene_first_node[b] = batch.graph.object_first_node[batch.graph.scene_first_object[b]];
+    }
+    // Each scene still being pushed advanced to its prediction, then turned after its last
+    // round when random_yaw; in parallel parts like the first build.
+    auto advance = [&](int begin, int end) {
+      StepWorkspace workspace;
+      std::vector<Pose> next;
+      for (int b = begin; b < end; ++b) {
+        const int steps = batch.scene_pushed[b];
+        if (round >= steps) continue;
+        Scene& scene = batch.scenes[b];
+        workspace.accelerations =
+            pushforward_accelerations_.middleRows(scene_first_node[b], scene.num_nodes())
+                .cast<double>();
+        integrate_next_poses(scene, next, workspace);
+        const SampleRef& sample = batch.samples[b];
+        const int frame = sample.frame - steps + round + 1;
+        if (trainer_config_.pushforward_skips_rest) {
+          const TrajectoryObject* truth = data_[sample.trajectory].objects.data();
+          for (size_t o = 0; o < next.size(); ++o) {
+            if (batch.scene_resting[b][o]) next[o] = truth[o].poses[frame];
+          }
+        }
+        advance_to_predicted(data_[sample.trajectory], frame, h, next, correction, scene,
+                             batch.scene_targets[b]);
+        if (config_.random_yaw && round == steps - 1) {
+          turn_about_vertical(batch.scene_yaw[b], scene, batch.scene_targets[b]);
         }
       }
-      advance_to_predicted(data_[sample.trajectory], sample.frame, h, next, correction, scene,
-                           batch.scene_targets[b]);
-      if (config_.random_yaw) {
-        turn_about_vertical(batch.scene_yaw[b], scene, batch.scene_targets[b]);
-      }
-    }
-  };
-  build_graph(omp_get_max_threads(), batch, advance);
+    };
+    build_graph(omp_get_max_threads(), batch, advance);
+  }
   times_.pushforward += seconds_since(start);
 }
 

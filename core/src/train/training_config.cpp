@@ -129,6 +129,8 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.pushforward_fraction; })},
       {"pushforward_skips_rest",
        plain<bool>([](TrainingConfig & c) -> auto& { return c.trainer.pushforward_skips_rest; })},
+      {"pushforward_steps",
+       plain<int>([](TrainingConfig & c) -> auto& { return c.trainer.pushforward_steps; })},
       {"statistics_warmup",
        plain<int>([](TrainingConfig & c) -> auto& { return c.trainer.statistics_warmup; })},
       {"data_seed",
@@ -327,6 +329,12 @@ void TrainingConfig::validate() const {
         "pushforward_fraction = {} (must be in [0, 1]: the share of steps that train on the "
         "network's own one-step prediction; 0: none)",
         trainer.pushforward_fraction));
+  }
+  if (trainer.pushforward_steps < 1 || trainer.pushforward_steps > kMaxPushforwardSteps) {
+    throw ConfigError(fmt::format(
+        "pushforward_steps = {} (must be in 1..{}: the network's steps from the frame a pushed "
+        "scene is drawn at to its own)",
+        trainer.pushforward_steps, kMaxPushforwardSteps));
   }
   if (!(trainer.weight_average >= 0.0f && trainer.weight_average < 1.0f)) {
     throw ConfigError(fmt::format(

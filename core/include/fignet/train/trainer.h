@@ -68,7 +68,14 @@ struct TrainerConfig {
   // errors in motion and contact, not to correct a resting body's prediction by the loss's
   // largest weight. false: every dynamic body is pushed.
   bool pushforward_skips_rest = false;
+  // Prediction steps of a pushed scene (1..kMaxPushforwardSteps): it is drawn this many frames
+  // early (fewer where the trajectory's first frames leave no room) and rolled out to its frame
+  // by the network, so the step trains on inputs with a short rollout's accumulated error, not
+  // one step's. Each step more costs one forward pass and one graph build more per pushed step.
+  int pushforward_steps = 1;
 };
+
+inline constexpr int kMaxPushforwardSteps = 8;
 
 // Everything besides the model that makes training continue exactly where it stopped: the
 // optimizer's moments and step count. Sampling needs no state: each step's generator is seeded
@@ -148,7 +155,7 @@ class Trainer {
   std::int64_t steps_done() const { return adam_.step(); }
   const std::vector<SampleRef>& samples() const { return samples_; }
   // The last step's scenes and their target rows as it trained on them (after the pushforward),
-  // and which of them were pushed forward: for tests and debugging.
+  // and how many frames each was pushed forward (0: not pushed): for tests and debugging.
   const std::vector<Scene>& batch_scenes() const { return current().scenes; }
   const std::vector<Points>& batch_targets() const { return current().scene_targets; }
   const std::vector<std::uint8_t>& batch_pushed() const { return current().scene_pushed; }
@@ -177,9 +184,9 @@ class Trainer {
     // Per-scene flags of resting bodies, only when rest_loss_weight != 1.
     std::vector<std::vector<std::uint8_t>> scene_resting;
     std::vector<std::uint64_t> scene_seeds;
-    // Per scene: 1 where it was drawn a frame early to be pushed forward before the step
-    // (pushforward_fraction), and its turn about the vertical when random_yaw (applied after
-    // the push).
+    // Per scene: how many frames early it was drawn to be pushed forward before the step
+    // (pushforward_fraction, pushforward_steps; 0: not pushed), and its turn about the vertical
+    // when random_yaw (applied after the push).
     std::vector<std::uint8_t> scene_pushed;
     std::vector<double> scene_yaw;
     // Batches are built by up to one builder per thread, each into its own part, then appended
