@@ -159,22 +159,24 @@ void print_regimes(const std::vector<Row>& rows) {
 }
 
 void print_table(const std::vector<Row>& rows) {
-  fmt::print("\n{:<34} {:>21} {:>21} {:>15} {:>10} {:>8}\n", "", "translation (m)",
-             "rotation (deg)", "penetration", "face-face", "");
-  fmt::print("{:<34} {:>10} {:>10} {:>10} {:>10} {:>7} {:>7} {:>10} {:>8}\n", "run", "mean", "last",
-             "mean", "last", "depth", "count", "edges", "ms/step");
+  fmt::print("\n{:<34} {:>21} {:>21} {:>7} {:>15} {:>10} {:>8}\n", "", "translation (m)",
+             "rotation (deg)", "", "penetration", "face-face", "");
+  fmt::print("{:<34} {:>10} {:>10} {:>10} {:>10} {:>7} {:>7} {:>7} {:>10} {:>8}\n", "run", "mean",
+             "last", "mean", "last", "travel", "depth", "count", "edges", "ms/step");
   for (const Row& row : rows) {
     const Evaluation& e = row.result;
     fmt::print(
-        "{:<34} {:>10.4f} {:>10.4f} {:>10.2f} {:>10.2f} {:>7.2f} {:>7.2f} {:>10.1f} {:>8.3f}\n",
+        "{:<34} {:>10.4f} {:>10.4f} {:>10.2f} {:>10.2f} {:>7.3f} {:>7.2f} {:>7.2f} {:>10.1f} "
+        "{:>8.3f}\n",
         fmt::format("{} ({})", row.name, row.kind), e.mean_translation, e.final_translation,
-        e.mean_rotation, e.final_rotation, e.penetration_depth_ratio, e.penetration_count_ratio,
-        e.face_edges_per_step, e.milliseconds_per_step);
+        e.mean_rotation, e.final_rotation, e.travel_ratio, e.penetration_depth_ratio,
+        e.penetration_count_ratio, e.face_edges_per_step, e.milliseconds_per_step);
   }
   fmt::print(
       "\nmean: over each rollout's predicted frames, then over trajectories; last: the final "
-      "frame. Penetration: ratio to the ground truth's (1 = as much as Bullet; nan: not measured "
-      "or none in the ground truth).\n");
+      "frame. Travel: the distance the bodies' centres cover in the rollouts over what they cover "
+      "in the ground truth (< 1: the model slows them too much). Penetration: ratio to the ground "
+      "truth's (1 = as much as Bullet; nan: not measured or none in the ground truth).\n");
 }
 
 nlohmann::json to_json(const Row& row) {
@@ -185,7 +187,9 @@ nlohmann::json to_json(const Row& row) {
     per_trajectory.push_back({{"mean_translation_m", t.mean_translation},
                               {"final_translation_m", t.final_translation},
                               {"mean_rotation_deg", t.mean_rotation},
-                              {"final_rotation_deg", t.final_rotation}});
+                              {"final_rotation_deg", t.final_rotation},
+                              {"predicted_travel_m", t.predicted_travel},
+                              {"true_travel_m", t.true_travel}});
   }
   nlohmann::json regimes = nullptr;
   if (row.one_step) {
@@ -213,6 +217,7 @@ nlohmann::json to_json(const Row& row) {
           {"final_translation_m", e.final_translation},
           {"mean_rotation_deg", e.mean_rotation},
           {"final_rotation_deg", e.final_rotation},
+          {"travel_ratio", number(e.travel_ratio)},
           {"penetration_depth_ratio", number(e.penetration_depth_ratio)},
           {"penetration_count_ratio", number(e.penetration_count_ratio)},
           {"face_edges_per_step", e.face_edges_per_step},

@@ -74,6 +74,7 @@ void TrainingLog::write_validation(std::int64_t step, const Evaluation& e,
                       {"valid_rotation_deg", e.mean_rotation},
                       {"valid_final_translation_m", e.final_translation},
                       {"valid_final_rotation_deg", e.final_rotation},
+                      {"valid_travel_ratio", e.travel_ratio},
                       {"valid_impacts", one_step.impact_errors.samples},
                       {"valid_unseen_impacts", one_step.unseen_impacts}};
   // valid_one_step_m_free_flight, valid_one_step_sigma_moving_contact, …

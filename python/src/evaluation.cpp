@@ -26,6 +26,8 @@ py::dict errors_dict(const RolloutErrors& e) {
   out["final_translation"] = e.final_translation;
   out["mean_rotation"] = e.mean_rotation;
   out["final_rotation"] = e.final_rotation;
+  out["predicted_travel"] = e.predicted_travel;
+  out["true_travel"] = e.true_travel;
   return out;
 }
 
@@ -124,6 +126,7 @@ angle (degrees); their means over frames first_predicted … end and their last 
         out["final_translation_m"] = e.final_translation;
         out["mean_rotation_deg"] = e.mean_rotation;
         out["final_rotation_deg"] = e.final_rotation;
+        out["travel_ratio"] = e.travel_ratio;
         out["penetration_depth_ratio"] = e.penetration_depth_ratio;
         out["penetration_count_ratio"] = e.penetration_count_ratio;
         out["face_edges_per_step"] = e.face_edges_per_step;

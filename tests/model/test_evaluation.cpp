@@ -71,6 +71,9 @@ TEST(Evaluation, SharesMergeToTheWhole) {
   EXPECT_EQ(parts.rotation, whole.rotation);
   EXPECT_DOUBLE_EQ(parts.mean_translation, whole.mean_translation);
   EXPECT_DOUBLE_EQ(parts.final_rotation, whole.final_rotation);
+  EXPECT_DOUBLE_EQ(parts.travel_ratio, whole.travel_ratio);
+  // The predictor's gravity is not the data's (none): its bodies travel farther.
+  EXPECT_GT(whole.travel_ratio, 1.0);
   EXPECT_THROW(EvaluationTotals::deserialize(std::vector<double>{2.0, 1.0}), ConfigError);
 }
 

@@ -80,6 +80,28 @@ TEST(Metrics, TranslationIsRmseAndRotationIsMeanAngle) {
               3.0 * 180 / M_PI, 1e-9);
 }
 
+// Travel: each predicted frame's step of every dynamic centre from the frame before, summed, in
+// the rollout and in the truth; kinematic objects and the given frames left out.
+TEST(Metrics, TravelSumsTheCentresStepsOverThePredictedFrames) {
+  const auto mesh = testing::small_cube();
+  Trajectory truth;
+  truth.objects.push_back(testing::ballistic_object(mesh, Vec3::Zero(), Vec3(1, 0, 0), Vec3::Zero(),
+                                                    4, 1.0, Vec3::Zero()));
+  TrajectoryObject pusher = testing::ballistic_object(mesh, Vec3(0, 5, 0), Vec3(0, 3, 0),
+                                                      Vec3::Zero(), 4, 1.0, Vec3::Zero());
+  pusher.kinematic = true;
+  truth.objects.push_back(pusher);
+  Trajectory predicted = truth;
+  predicted.objects[0].poses[2].position = Vec3(1.5, 0, 0);  // 0.5 m from frame 1
+  predicted.objects[0].poses[3].position = Vec3(1.5, 0, 2);  // then 2 m up
+  predicted.objects[1].poses[3].position = Vec3(0, 100, 0);  // kinematic: not counted
+  const RolloutErrors errors = rollout_errors(predicted, truth, 2);
+  EXPECT_NEAR(errors.true_travel, 2.0, 1e-12);  // frames 1 → 2 → 3, 1 m each
+  EXPECT_NEAR(errors.predicted_travel, 2.5, 1e-12);
+  // From the first frame on, the first frame has no step to count.
+  EXPECT_NEAR(rollout_errors(truth, truth, 0).true_travel, 3.0, 1e-12);
+}
+
 TEST(Metrics, PenetrationCountsCrossingFacesAndDepth) {
   const auto mesh = testing::small_cube(0.5);
   Trajectory scene;

@@ -33,13 +33,17 @@ def test_evaluation_equals_fignet_eval_on_the_same_file(tmp_path, cli, model, so
     )
     (run,) = [r for r in json.loads(report.read_text())["runs"] if r["name"] != "ballistic"]
     ours = fignet.evaluate(model, truths)
-    for key in ("mean_translation_m", "final_translation_m", "mean_rotation_deg"):
+    for key in ("mean_translation_m", "final_translation_m", "mean_rotation_deg", "travel_ratio"):
         assert abs(ours[key] - run[key]) <= 1e-9 * max(1.0, abs(run[key])), key
     np.testing.assert_allclose(ours["translation_per_frame_m"], run["translation_per_frame_m"],
                                rtol=1e-9, atol=1e-12)
     # The same through rollout() and rollout_errors(), one trajectory at a time.
     means = [fignet.rollout_errors(fignet.rollout(model, t), t)["mean_translation"] for t in truths]
     assert abs(np.mean(means) - run["mean_translation_m"]) <= 1e-9
+    # Travel: what the rollouts' centres cover over the truth's, summed over the trajectories.
+    errors = [fignet.rollout_errors(fignet.rollout(model, t), t) for t in truths]
+    travel = sum(e["predicted_travel"] for e in errors) / sum(e["true_travel"] for e in errors)
+    assert abs(travel - run["travel_ratio"]) <= 1e-9
 
 
 def test_rollouts_keep_the_given_frames_and_match_one_step_predictions(model):

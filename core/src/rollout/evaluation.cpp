@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <limits>
 
 #include "fignet/error.h"
 #include "fignet/rollout/rollout.h"
@@ -38,6 +39,7 @@ Evaluation summarize(const EvaluationTotals& totals, const EvaluationOptions& op
   if (result.trajectories == 0) return result;
   // Per-frame means over the trajectories long enough to have that frame.
   std::vector<int> frame_counts;
+  double predicted_travel = 0.0, true_travel = 0.0;
   for (const RolloutErrors& errors : totals.per_trajectory) {
     const size_t frames = errors.translation.size();
     if (result.translation.size() < frames) {
@@ -54,7 +56,11 @@ Evaluation summarize(const EvaluationTotals& totals, const EvaluationOptions& op
     result.final_translation += errors.final_translation;
     result.mean_rotation += errors.mean_rotation;
     result.final_rotation += errors.final_rotation;
+    predicted_travel += errors.predicted_travel;
+    true_travel += errors.true_travel;
   }
+  result.travel_ratio =
+      true_travel > 0.0 ? predicted_travel / true_travel : std::numeric_limits<double>::quiet_NaN();
   const double n = result.trajectories;
   for (size_t f = 0; f < result.translation.size(); ++f) {
     result.translation[f] /= frame_counts[f];
@@ -107,7 +113,8 @@ EvaluationTotals& EvaluationTotals::operator+=(const EvaluationTotals& other) {
 }
 
 // [trajectories, steps, face edges, seconds, 4 penetration totals, then per trajectory: frames,
-// translation…, rotation…, mean and final translation, mean and final rotation].
+// translation…, rotation…, mean and final translation, mean and final rotation, predicted and
+// true travel].
 std::vector<double> EvaluationTotals::serialize() const {
   std::vector<double> out = {static_cast<double>(per_trajectory.size()),
                              static_cast<double>(steps),
@@ -121,8 +128,8 @@ std::vector<double> EvaluationTotals::serialize() const {
     out.push_back(static_cast<double>(e.translation.size()));
     out.insert(out.end(), e.translation.begin(), e.translation.end());
     out.insert(out.end(), e.rotation.begin(), e.rotation.end());
-    out.insert(out.end(),
-               {e.mean_translation, e.final_translation, e.mean_rotation, e.final_rotation});
+    out.insert(out.end(), {e.mean_translation, e.final_translation, e.mean_rotation,
+                           e.final_rotation, e.predicted_travel, e.true_travel});
   }
   return out;
 }
@@ -148,6 +155,8 @@ EvaluationTotals EvaluationTotals::deserialize(std::span<const double> values, s
     e.final_translation = next();
     e.mean_rotation = next();
     e.final_rotation = next();
+    e.predicted_travel = next();
+    e.true_travel = next();
     totals.per_trajectory.push_back(std::move(e));
   }
   if (consumed) *consumed = at;

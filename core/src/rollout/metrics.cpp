@@ -31,6 +31,10 @@ RolloutErrors rollout_errors(const Trajectory& predicted, const Trajectory& trut
       squared += (p.position - t.position).squaredNorm();
       angle += rotation_angle_degrees(p.orientation, t.orientation);
       ++dynamic;
+      if (f >= first_predicted && f > 0) {
+        errors.predicted_travel += (p.position - predicted.objects[o].poses[f - 1].position).norm();
+        errors.true_travel += (t.position - truth.objects[o].poses[f - 1].position).norm();
+      }
     }
     if (dynamic == 0) continue;
     errors.translation[f] = std::sqrt(squared / dynamic);

@@ -25,6 +25,9 @@ struct Evaluation {
   std::vector<double> translation, rotation;
   // Over trajectories: mean of each rollout's mean error and of its last-frame error.
   double mean_translation = 0, final_translation = 0, mean_rotation = 0, final_rotation = 0;
+  // The distance the bodies travel in the rollouts over the distance they travel in the truth,
+  // both summed over every trajectory (RolloutErrors::predicted_travel); NaN when nothing moves.
+  double travel_ratio = 0;
   // Penetration of the rollouts as a ratio to the ground truth's (seed H.1); NaN if not measured
   // or when the ground truth has none.
   double penetration_depth_ratio = 0, penetration_count_ratio = 0;

@@ -15,6 +15,11 @@ struct RolloutErrors {
   std::vector<double> rotation;     // per frame, degrees
   double mean_translation = 0, final_translation = 0;  // over frames first_predicted … end
   double mean_rotation = 0, final_rotation = 0;
+  // Distance the dynamic objects' centres travel over the predicted frames (each frame's step
+  // from the one before, summed over objects), in the rollout and in the truth, metres: their
+  // ratio tells a model that slows bodies too much (< 1) or keeps them going (> 1), which the
+  // errors above do not.
+  double predicted_travel = 0, true_travel = 0;
 };
 
 // Compares a rollout with the truth over frames [first_predicted, end).
