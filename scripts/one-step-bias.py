@@ -18,7 +18,7 @@ import fignet
 
 FLOOR_CONTACT_M = 0.02  # lowest vertex within this of the floor: on the floor
 AIR_M = 0.10  # lowest vertex above this: clear of the floor (other bodies may touch it)
-IMPACT_M_S = 0.5  # vertical velocity change beyond gravity's by this much: an impact
+IMPACT_G = 2.0  # an impact: the true acceleration differs from gravity by this many g (fignet eval's)
 SPEED_BANDS = [(0, 0.05), (0.05, 0.3), (0.3, 1), (1, 2), (2, 4), (4, float("inf"))]
 
 
@@ -61,7 +61,7 @@ def report(rows, dt, gravity):
     direction = v[:, :2] / np.maximum(speed, 1e-9)[:, None]
     along_true = ((v_true[:, :2] - v[:, :2]) * direction).sum(1) / dt
     along_pred = ((v_pred[:, :2] - v[:, :2]) * direction).sum(1) / dt
-    impact = np.abs(v_true[:, 2] - v[:, 2] - gravity * dt) > IMPACT_M_S
+    impact = np.linalg.norm((v_true - v) / dt - gravity, axis=1) > IMPACT_G * np.linalg.norm(gravity)
     on_floor, in_air = lowest < FLOOR_CONTACT_M, lowest > AIR_M
     print(f"{len(rows)} object-steps\n")
     print("On the floor without an impact, acceleration along the horizontal motion (m/s²):\n")
@@ -94,7 +94,7 @@ def main():
     args = parser.parse_args()
     model = fignet.load_model(args.model)
     trajectories = fignet.read_trajectories(args.data)[: args.trajectories]
-    report(object_steps(model, trajectories), model.time_step, model.gravity[2])
+    report(object_steps(model, trajectories), model.time_step, np.asarray(model.gravity))
 
 
 if __name__ == "__main__":
