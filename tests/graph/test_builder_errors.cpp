@@ -69,6 +69,19 @@ TEST(GraphBuilderErrors, BadConfigValues) {
   } catch (const ConfigError& e) {
     expect_contains(e.what(), "distance_log_scale = -0.001");
   }
+  config = {};
+  config.contact_motion = true;
+  config.contact_motion_dead_zone = -1e-3;
+  EXPECT_THROW(GraphBuilder{config}, ConfigError);
+  config.contact_motion = false;
+  config.contact_motion_dead_zone = 1e-3;  // would shape columns that are not there
+  try {
+    GraphBuilder{config};
+    FAIL();
+  } catch (const ConfigError& e) {
+    expect_contains(e.what(), "contact_motion_dead_zone = 0.001");
+    expect_contains(e.what(), "needs contact_motion");
+  }
 }
 
 TEST(GraphBuilderErrors, CandidatePairOutOfRange) {

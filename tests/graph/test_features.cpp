@@ -230,6 +230,32 @@ TEST_F(TwoTetrahedra, ContactMotionOfATranslation) {
   }
 }
 
+// contact_motion_dead_zone δ shrinks u by δ along itself and zeroes it below δ: the 2 cm
+// translation above reads 1.5 cm at δ = 5 mm (|u| and u·n_s with it) and nothing at δ = 3 cm,
+// while the 34 columns before it stay as they were.
+TEST_F(TwoTetrahedra, ContactMotionDeadZone) {
+  for (const double dead_zone : {0.005, 0.03}) {
+    SCOPED_TRACE("dead zone " + std::to_string(dead_zone));
+    GraphConfig config;
+    config.contact_motion = true;
+    config.contact_motion_dead_zone = dead_zone;
+    Graph graph;
+    GraphBuilder(config).build(scene_, graph);
+    ASSERT_EQ(graph.face_edges.features.cols(), 39);
+    ASSERT_EQ(graph.face_edges.size(), graph_.face_edges.size());
+    const double length = std::max(0.02 - dead_zone, 0.0);
+    for (int e = 0; e < graph_.face_edges.size(); ++e) {
+      const float* plain = graph_.face_edges.features.row(e);
+      std::vector<double> expected(plain, plain + 34);
+      const bool a_sends = graph.node_object[graph.face_edges.senders[3 * e]] == 0;
+      const Vec3 u(a_sends ? -length : length, 0, 0);
+      const Vec3 n_s(plain[31], plain[32], plain[33]);
+      expected.insert(expected.end(), {u.x(), u.y(), u.z(), u.norm(), u.dot(n_s)});
+      expect_row(graph.face_edges.features.row(e), expected);
+    }
+  }
+}
+
 // The same under rotation, against the rigid motions themselves: A turns about z (0.05 then
 // 0.12 rad) while B slides, and each closest point's motion is where the body's last-frame pose
 // puts that material point, subtracted from where it is now.

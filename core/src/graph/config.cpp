@@ -28,6 +28,14 @@ void GraphConfig::validate() const {
   if (!(distance_log_scale >= 0.0) || !std::isfinite(distance_log_scale)) {
     fail("distance_log_scale", distance_log_scale, "must be >= 0 metres (0: off)");
   }
+  if (!(contact_motion_dead_zone >= 0.0) || !std::isfinite(contact_motion_dead_zone)) {
+    fail("contact_motion_dead_zone", contact_motion_dead_zone,
+         "must be >= 0 metres per frame (0: off)");
+  }
+  if (contact_motion_dead_zone > 0.0 && !contact_motion) {
+    fail("contact_motion_dead_zone", contact_motion_dead_zone,
+         "shapes the contact motion's columns: needs contact_motion");
+  }
   if (!(face_span_limit >= 0.0) || !std::isfinite(face_span_limit)) {
     fail("face_span_limit", face_span_limit, "must be >= 0 metres (0: no limit)");
   }

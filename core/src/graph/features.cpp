@@ -184,7 +184,8 @@ Vec3 point_motion(const PosedMesh& posed, int face, const Vec3& p) {
 }
 
 // [d_rs, |d_rs|, (d_sj, |d_sj|)_j, (d_rj, |d_rj|)_j, n_r, n_s] (seed C.1.1), then
-// ln(1 + |d_rs|/s) when distance_log_scale s > 0, then [u, |u|, u·n_s] when contact_motion.
+// ln(1 + |d_rs|/s) when distance_log_scale s > 0, then [u, |u|, u·n_s] when contact_motion
+// (u shrunk by contact_motion_dead_zone).
 void put_face_edge(const GraphConfig& config, const PosedMesh& sender, int sender_face,
                    const Vec3& p_s, int sender_first, const PosedMesh& receiver, int receiver_face,
                    const Vec3& p_r, int receiver_first, FaceEdgeSet& out) {
@@ -202,8 +203,12 @@ void put_face_edge(const GraphConfig& config, const PosedMesh& sender, int sende
   if (const double scale = config.distance_log_scale; scale > 0.0)
     *row++ = static_cast<float>(std::log1p(d.norm() / scale));
   if (config.contact_motion) {
-    const Vec3 u =
-        point_motion(receiver, receiver_face, p_r) - point_motion(sender, sender_face, p_s);
+    Vec3 u = point_motion(receiver, receiver_face, p_r) - point_motion(sender, sender_face, p_s);
+    // Shrinking (not clipping) keeps the columns continuous in u across the dead zone's edge.
+    if (const double dead_zone = config.contact_motion_dead_zone; dead_zone > 0.0) {
+      const double length = u.norm();
+      u = length > dead_zone ? Vec3(u * (1.0 - dead_zone / length)) : Vec3::Zero();
+    }
     row = put_vector(row, u);
     *row++ = static_cast<float>(u.dot(n_s));
   }

@@ -68,6 +68,7 @@ void write_config(H5::Group group, const ModelConfig& c) {
   write_attribute(group, "velocity_log_scale", c.graph.velocity_log_scale);
   write_attribute(group, "distance_log_scale", c.graph.distance_log_scale);
   write_attribute(group, "contact_motion", static_cast<long long>(c.graph.contact_motion));
+  write_attribute(group, "contact_motion_dead_zone", c.graph.contact_motion_dead_zone);
   write_attribute(group, "noise", std::string(c.noise == NoiseKind::kRigid ? "rigid" : "vertex"));
   write_attribute(group, "noise_correction", c.noise_correction);
   write_attribute(group, "random_yaw", static_cast<long long>(c.random_yaw));
@@ -129,6 +130,8 @@ ModelConfig read_config(const H5::Group& group) {
       read_double_or(group, "velocity_log_scale", c.graph.velocity_log_scale);
   c.graph.distance_log_scale =
       read_double_or(group, "distance_log_scale", c.graph.distance_log_scale);
+  c.graph.contact_motion_dead_zone =
+      read_double_or(group, "contact_motion_dead_zone", c.graph.contact_motion_dead_zone);
   if (group.attrExists("noise")) {
     const std::string noise = read_string(group, "noise");
     if (noise != "vertex" && noise != "rigid") {

@@ -94,6 +94,9 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        plain<double>([](TrainingConfig & c) -> auto& { return c.model.graph.distance_log_scale; })},
       {"contact_motion",
        plain<bool>([](TrainingConfig & c) -> auto& { return c.model.graph.contact_motion; })},
+      {"contact_motion_dead_zone", plain<double>([](TrainingConfig & c) -> auto& {
+         return c.model.graph.contact_motion_dead_zone;
+       })},
       {"noise_std", plain<double>([](TrainingConfig & c) -> auto& { return c.model.noise_std; })},
       {"noise",
        named_enum<NoiseKind>([](TrainingConfig & c) -> auto& { return c.model.noise; },

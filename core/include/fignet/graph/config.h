@@ -50,6 +50,11 @@ struct GraphConfig {
   // which node velocities give only through six vertices' latents; the one-step error of
   // impacts (4× moving contact's, and too soft) comes from that instant.
   bool contact_motion = false;
+  // > 0: u is shrunk toward zero by this many metres per frame before it is written, u·(1 −
+  // δ/|u|) where |u| > δ and 0 below. Resting contacts then read u = 0 in training as in a
+  // rollout, instead of the training noise's few tenths of a millimetre (a rollout from rest
+  // starts at exactly 0, where the network had never been taught); 0 keeps u whole.
+  double contact_motion_dead_zone = 0.0;
 
   // Throws ConfigError naming the first invalid field and its value.
   void validate() const;
