@@ -3,9 +3,7 @@
 
 A stack of MOVi cubes (1.4 m, 3 kg, friction 0.8, as `fignet stress`'s "stack of N MOVi cubes",
 each resting on the 5 mm collision margin) is rolled out by the network alone from frames that do
-not move, as a rollout from rest starts, or (--noise) from a history that carries the training's
-rigid-body random walk (noise_std at the last frame, rotations scaled by the body's radius, the
-oldest frame clean). It prints each cube's speed over each predicted frame: the truth is 0, free
+not move, as a rollout from rest starts. It prints each cube's speed over each predicted frame: the truth is 0, free
 fall from rest reaches g·dt in one frame, and a speed that rises and falls every other frame is
 a network overshooting its own answer to contact. Needs the Python module
 (PYTHONPATH=build/release/python) and numpy.
@@ -30,31 +28,15 @@ def cube_mesh(half):
     return vertices.astype(float), faces
 
 
-def quaternion(rotation_vector):
-    angle = np.linalg.norm(rotation_vector)
-    if angle == 0:
-        return np.array([1.0, 0, 0, 0])
-    return np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * rotation_vector / angle])
-
-
-def stack(model, levels, noise_std, frames, rng):
-    """A trajectory of `levels` cubes standing still for history + 1 + `frames` frames; with
-    noise_std > 0 the first history + 1 carry the training's rigid random walk."""
+def stack(model, levels, frames):
+    """A trajectory of `levels` cubes standing still for history + 1 + `frames` frames."""
     vertices, faces = cube_mesh(HALF)
-    radius = np.linalg.norm(vertices, axis=1).max()
     history = model.history
     trajectory = fignet.Trajectory(time_step=model.time_step, gravity=model.gravity)
     for level in range(levels):
         center = np.array([0, 0, HALF + GAP + level * (2 * HALF + GAP)])
         positions = np.tile(center, (history + 1 + frames, 1))
         quaternions = np.tile([1.0, 0, 0, 0], (history + 1 + frames, 1))
-        translation, rotation = np.zeros(3), np.zeros(3)
-        step_std = noise_std / np.sqrt(history)
-        for frame in range(1, history + 1):
-            translation += rng.normal(0, step_std, 3)
-            rotation += rng.normal(0, step_std, 3) / radius
-            positions[frame] = center + translation
-            quaternions[frame] = quaternion(rotation)
         trajectory.add_object(vertices, faces, positions, quaternions, mass=DENSITY * (2 * HALF) ** 3,
                               friction=0.8, restitution=0.7)
     return trajectory
@@ -72,22 +54,13 @@ def main():
     parser.add_argument("model", help="model file (.h5)")
     parser.add_argument("--levels", type=int, default=2, help="cubes in the stack (default 2)")
     parser.add_argument("--frames", type=int, default=8, help="frames to predict (default 8)")
-    parser.add_argument("--noise", type=float, default=0.0,
-                        help="random-walk noise at the last given frame, m (default 0: exact rest)")
-    parser.add_argument("--draws", type=int, default=8,
-                        help="with --noise: draws averaged (default 8)")
-    parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     if args.levels < 1 or args.frames < 1:
         parser.error("--levels and --frames must be at least 1")
     model = fignet.load_model(args.model)
-    rng = np.random.default_rng(args.seed)
-    draws = args.draws if args.noise > 0 else 1
-    table = np.mean([speeds(model, stack(model, args.levels, args.noise, args.frames, rng))
-                     for _ in range(draws)], axis=0)
+    table = speeds(model, stack(model, args.levels, args.frames))
     free_fall = np.linalg.norm(model.gravity) * model.time_step
-    given = "at exact rest" if args.noise == 0 else f"with {args.noise:g} m of noise ({draws} draws)"
-    print(f"{args.model}: a stack of {args.levels} MOVi cubes given {given}, the network alone; "
+    print(f"{args.model}: a stack of {args.levels} MOVi cubes at exact rest, the network alone; "
           f"free fall from rest reaches {free_fall:.3f} m/s in one frame\n")
     print("| frame | " + " | ".join(f"cube {k + 1} speed (m/s)" for k in range(args.levels)) + " |")
     print("|---" * (args.levels + 1) + "|")
