@@ -7,6 +7,8 @@
 # Each RUN ARGS is `fignet train`'s arguments without --threads and --device; --out names the
 # run. For each run DEST receives NAME.ckpt.h5 and NAME.tar (its model, log and console output):
 # two files per run, so that three runs stay within what a device call returns (8 files).
+# SECONDS is the training's share of the call: leave ~60 s of the call's limit for unpacking,
+# data, the CUDA tests and the checkpoints (a run stopped during a validation finishes it first).
 # Datasets under data/ that a run names and that are missing are generated from their seeds
 # (the commands of the runs' READMEs), so only the bundle and the checkpoints need to travel.
 # Environment: BUNDLE (a .tar.xz of the bundle, unpacked when .gpu/ is absent; default
