@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The validations of `fignet train` logs (OUT.log.jsonl) as one Markdown table.
 
-Usage: scripts/training-log.py [--batch NAME=B ...] [--cost NAME=C ...] [--fit]
+Usage: scripts/training-log.py [--batch NAME=B ...] [--cost NAME=C ...] [--against NAME] [--fit]
                                [--fit-from SAMPLES] [--plot PNG] LOG [LOG ...]
 
 One row per validation of each log: steps, samples seen (the log's "samples"; logs from before
@@ -14,6 +14,11 @@ equal samples, and at equal compute when their samples cost differently.
 the others (e.g. the ratio of the two configs' time per step, measured in one run on one machine):
 the table then has a column of compute, samples × C, in samples of the runs without --cost, and
 --plot draws the curves against it.
+
+--against NAME adds a column: each other run's translation error and one-step error in moving
+contact relative to the run NAME (its file name, or the one run whose name starts with NAME) at
+the same samples, in per cent (−12.0 % is 12 % below NAME's); "—" where NAME has no validation
+at those samples.
 
 --fit adds, per log, the learning curve as a power law: a least-squares line through
 ln(translation) against ln(samples) over the validations from --fit-from samples on, its slope
@@ -122,6 +127,8 @@ def main() -> int:
     parser.add_argument("--cost", action="append", default=[], metavar="NAME=C",
                         help="a sample of the run whose name starts with NAME costs C samples of "
                              "the others (adds a compute column)")
+    parser.add_argument("--against", metavar="NAME",
+                        help="add each run's difference from the run NAME at equal samples (%%)")
     parser.add_argument("--fit", action="store_true",
                         help="fit a power law to each log's validation translation error")
     parser.add_argument("--fit-from", type=parse_count, default=0.0, metavar="SAMPLES",
@@ -162,11 +169,42 @@ def main() -> int:
             print(f"training-log.py: {e}", file=sys.stderr)
             return 1
 
+    reference = None
+    if args.against is not None:
+        names = [name for name, _ in runs]
+        matches = [args.against] if args.against in names else [
+            name for name in names if name.startswith(args.against)]
+        if len(matches) != 1:
+            which = "no run" if not matches else f"{len(matches)} runs ({', '.join(matches)})"
+            print(f"training-log.py: --against {args.against}: {which} by that name",
+                  file=sys.stderr)
+            return 2
+        reference = {v["samples"]: v for v in dict(runs)[matches[0]] if v["samples"] is not None}
+
+    def against(name, entry):
+        """The cell of --against: per cent differences from the reference at equal samples."""
+        if name == args.against or (reference is not None and entry is reference.get(
+                entry["samples"])):
+            return "reference"
+        other = reference.get(entry["samples"])
+        if other is None:
+            return "—"
+        cells = []
+        for key in ("valid_translation_m", "valid_one_step_m_moving_contact"):
+            if key in entry and key in other and other[key] > 0:
+                cells.append(f"{100 * (entry[key] / other[key] - 1):+.1f} %".replace("-", "−"))
+            else:
+                cells.append("-")
+        return " / ".join(cells)
+
     with_compute = bool(costs)
     compute_header = " compute |" if with_compute else ""
+    against_header = (f" against {args.against} at equal samples: translation / moving contact |"
+                      if reference is not None else "")
     print(f"| run | steps | samples |{compute_header} translation (m) | rotation (°) "
-          "| one step: free flight / moving contact / rest / impacts (mm) |")
-    print("|---|---|---|" + ("---|" if with_compute else "") + "---|---|---|")
+          f"| one step: free flight / moving contact / rest / impacts (mm) |{against_header}")
+    print("|---|---|---|" + ("---|" if with_compute else "") + "---|---|---|"
+          + ("---|" if reference is not None else ""))
     for name, validations in runs:
         for entry in validations:
             seen = entry["samples"]
@@ -178,9 +216,10 @@ def main() -> int:
                 f"{1e3 * entry[key]:.2f}" if key in entry else "-"
                 for key in ("valid_one_step_m_free_flight", "valid_one_step_m_moving_contact",
                             "valid_one_step_m_rest", "valid_one_step_m_impacts"))
+            difference = f" {against(name, entry)} |" if reference is not None else ""
             print(f"| {name} | {entry['step']} | {samples} |{compute} "
                   f"{entry['valid_translation_m']:.3f} | {entry['valid_rotation_deg']:.1f} "
-                  f"| {one_step} |")
+                  f"| {one_step} |{difference}")
 
     fits = {}
     if args.fit or args.plot:

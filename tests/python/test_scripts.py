@@ -105,6 +105,25 @@ def test_cost_puts_runs_on_a_common_compute_axis(source_dir, tmp_path):
         assert result.returncode == 2 and f"--cost {bad}" in result.stderr
 
 
+def test_against_gives_each_run_its_difference_at_equal_samples(source_dir, tmp_path):
+    # Per cent from the reference at the same samples; "—" where it has no validation there; the
+    # reference named by a prefix that fits one run only, and refused where it fits none or two.
+    write_log(tmp_path / "shipped.h5.log.jsonl", [(10_000, 2.0), (20_000, 1.0)])
+    write_log(tmp_path / "lever.h5.log.jsonl", [(10_000, 1.5), (20_000, 1.1), (30_000, 0.9)])
+    logs = [str(tmp_path / f"{n}.h5.log.jsonl") for n in ("shipped", "lever")]
+    result = run_training_log(source_dir, "--against", "ship", *logs)
+    assert result.returncode == 0, result.stderr
+    assert "against ship at equal samples" in result.stdout.splitlines()[0]
+    cells = {(row[0], row[2]): row[-1] for row in table_rows(result.stdout)}
+    assert cells[("lever", "10k")] == "−25.0 % / -", result.stdout
+    assert cells[("lever", "20k")] == "+10.0 % / -"
+    assert cells[("lever", "30k")] == "—"
+    assert cells[("shipped", "10k")] == cells[("shipped", "20k")] == "reference"
+    for name, said in (("nothing", "no run"), ("", "2 runs")):
+        result = run_training_log(source_dir, "--against", name, *logs)
+        assert result.returncode == 2 and said in result.stderr, result.stderr
+
+
 def test_batch_counts_samples_of_old_logs_by_the_longest_prefix(source_dir, tmp_path):
     # Logs from before the "samples" field: steps × the batch given for the longest prefix of
     # the run's name, as --cost decides.
