@@ -197,3 +197,23 @@ def test_model_card_names_what_it_lacks(source_dir, tmp_path):
     result = card(model)
     assert result.returncode == 2 and "data/movi-a/test.h5 is missing" in result.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_rest_response_stacks_movi_cubes_as_trained(source_dir):
+    # The stack is built of MOVi-A's own cube (each side split 3×3), not an 8-corner cube the
+    # network never saw, and the table has one row per predicted frame and a column per cube.
+    import importlib.util
+    import numpy as np
+    spec = importlib.util.spec_from_file_location(
+        "rest_response", source_dir / "scripts" / "rest-response.py")
+    rest_response = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(rest_response)
+    vertices, faces = rest_response.movi_cube_mesh()
+    assert vertices.shape == (56, 3) and faces.shape == (108, 3)
+    assert np.allclose(vertices.min(axis=0), -0.7) and np.allclose(vertices.max(axis=0), 0.7)
+    result = subprocess.run([sys.executable, str(source_dir / "scripts" / "rest-response.py"),
+                             str(source_dir / "models" / "movi-a-small.h5"), "--levels", "3",
+                             "--frames", "2"], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    rows = [line for line in result.stdout.splitlines() if re.match(r"\| \d+ \|", line)]
+    assert len(rows) == 2 and all(len(row.strip("|").split("|")) == 4 for row in rows), result.stdout
