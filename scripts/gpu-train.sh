@@ -5,7 +5,8 @@
 # repository root, with the bundle of scripts/bundle-for-gpu.sh.
 #   scripts/gpu-train.sh SECONDS DEST 'RUN 1 ARGS' ['RUN 2 ARGS' ['RUN 3 ARGS']]
 # Each RUN ARGS is `fignet train`'s arguments without --threads and --device; --out names the
-# run. For each run DEST receives NAME.ckpt.h5 and NAME.tar (its model, log and console output):
+# run. For each run DEST receives its checkpoint under its own name (NAME.h5.ckpt.h5 for --out
+# NAME.h5) and NAME.tar (its model, log and console output):
 # two files per run, so that three runs stay within what a device call returns (8 files).
 # SECONDS is the training's share of the call: leave ~60 s of the call's limit for unpacking,
 # data, the CUDA tests and the checkpoints (a run stopped during a validation finishes it first).
@@ -110,7 +111,7 @@ for ((r = 0; r < ${#outs[@]}; ++r)); do
     status=1
     continue
   fi
-  cp "$out.ckpt.h5" "$dest/$name.ckpt.h5"
+  cp "$out.ckpt.h5" "$dest/$(basename "$out").ckpt.h5"
   files=("$name.console.txt" "$name.h5.log.jsonl")
   [[ -f "$out" ]] && files+=("$name.h5")
   tar cf "$dest/$name.tar" -C "$(dirname "$out")" "${files[@]}"
