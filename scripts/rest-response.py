@@ -2,11 +2,11 @@
 """A model's answer to a stack at rest, frame by frame: the first frames of `fignet stress`'s stack.
 
 A stack of MOVi cubes (MOVi-A's own 1.4 m cube mesh of 56 vertices, 3 kg, friction 0.8, as
-`fignet stress`'s "stack of N MOVi cubes", each resting on the 5 mm collision margin) is rolled out by the network alone from frames that do
-not move, as a rollout from rest starts. It prints each cube's speed over each predicted frame: the truth is 0, free
-fall from rest reaches g·dt in one frame, and a speed that rises and falls every other frame is
-a network overshooting its own answer to contact. Needs the Python module
-(PYTHONPATH=build/release/python) and numpy.
+`fignet stress`'s "stack of N MOVi cubes", each resting on the 5 mm collision margin) is rolled
+out by the network alone from frames that do not move, as a rollout from rest starts. It prints
+each cube's speed over each predicted frame: the truth is 0, free fall from rest reaches g·dt in
+one frame, and a speed that rises and falls every other frame is a network overshooting its own
+answer to contact. Needs the Python module (PYTHONPATH=build/release/python) and numpy.
 
     scripts/rest-response.py models/movi-a-small.h5 --levels 2 --frames 8
 """

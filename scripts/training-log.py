@@ -179,12 +179,13 @@ def main() -> int:
             print(f"training-log.py: --against {args.against}: {which} by that name",
                   file=sys.stderr)
             return 2
-        reference = {v["samples"]: v for v in dict(runs)[matches[0]] if v["samples"] is not None}
+        reference_name = matches[0]
+        reference = {v["samples"]: v for v in dict(runs)[reference_name]
+                     if v["samples"] is not None}
 
     def against(name, entry):
         """The cell of --against: per cent differences from the reference at equal samples."""
-        if name == args.against or (reference is not None and entry is reference.get(
-                entry["samples"])):
+        if name == reference_name:
             return "reference"
         other = reference.get(entry["samples"])
         if other is None:
