@@ -394,7 +394,8 @@ TEST(FIGNetWorld, ARealModelStepsAMoviASceneWithoutNaNAsEvalRolloutsDo) {
   // frames, a core rollout reproduces the world's later frames. Bullet keeps transforms in
   // float, so they agree to float rounding compounded over the steps (up to 1e-5 m over 20),
   // not bit for bit. (Before RigidBodies handed the world the bodies' own meshes, the world saw
-  // the hulls' triangulation and this was off by 3e-4 m.)
+  // the hulls' triangulation and this was off by 3e-4 m. A trained model at a resting contact
+  // turns that rounding into micrometres a step: docs/graph.md, "Ties at resting contact".)
   ModelPredictor predictor(model);
   const Trajectory replayed = core_rollout(predictor, rollout);
   const int first = model->config().graph.history + 1;

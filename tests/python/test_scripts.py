@@ -217,3 +217,38 @@ def test_rest_response_stacks_movi_cubes_as_trained(source_dir):
     assert result.returncode == 0, result.stderr
     rows = [line for line in result.stdout.splitlines() if re.match(r"\| \d+ \|", line)]
     assert len(rows) == 2 and all(len(row.strip("|").split("|")) == 4 for row in rows), result.stdout
+
+
+def test_rest_response_perturbation_moves_a_falling_cube_in_proportion(source_dir):
+    # --perturb moves only the history the network reads: a cube in free flight, 10 m up, answers
+    # a perturbation σ by a few σ (x' = 2x − x₋₁ + a), where a resting stack's tie would answer
+    # micrometres; and the table has a row per draw and a column per cube.
+    import importlib.util
+    import numpy as np
+    import fignet
+    spec = importlib.util.spec_from_file_location(
+        "rest_response", source_dir / "scripts" / "rest-response.py")
+    rest_response = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(rest_response)
+    model = fignet.load_model(str(source_dir / "models" / "movi-a-small.h5"))
+    vertices, faces = rest_response.movi_cube_mesh()
+    frames = model.history + 2
+    falling = fignet.Trajectory(time_step=model.time_step, gravity=model.gravity)
+    heights = 10.0 - 0.5 * 10.0 * (np.arange(frames) * model.time_step) ** 2
+    positions = np.stack([np.zeros(frames), np.zeros(frames), heights], axis=1)
+    falling.add_object(vertices, faces, positions, np.tile([1.0, 0, 0, 0], (frames, 1)), mass=3.0)
+    sigma = 1e-6
+    response = rest_response.one_step_response(model, falling, sigma, draws=4)
+    assert response.shape == (4, 1)
+    assert np.all(response > 0.3 * sigma) and np.all(response < 20 * sigma), response
+    result = subprocess.run([sys.executable, str(source_dir / "scripts" / "rest-response.py"),
+                             str(source_dir / "models" / "movi-a-small.h5"), "--levels", "2",
+                             "--perturb", "1e-10", "--draws", "3"], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    rows = [line for line in result.stdout.splitlines() if re.match(r"\| \d+ \|", line)]
+    assert len(rows) == 3, result.stdout
+    assert all(len(row.strip("|").split("|")) == 3 for row in rows), result.stdout
+    bad = subprocess.run([sys.executable, str(source_dir / "scripts" / "rest-response.py"),
+                          str(source_dir / "models" / "movi-a-small.h5"), "--perturb", "-1"],
+                         capture_output=True, text=True)
+    assert bad.returncode != 0 and "--perturb must be > 0" in bad.stderr
