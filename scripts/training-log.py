@@ -111,7 +111,11 @@ def stress_cell(figures) -> str:
         return "not finite"
     late = f", late {figures['late_speed_m_s']:.2f} m/s"
     if "drift_m" in figures:
-        return f"{figures['drift_m']:.3f} m / {figures['drift_deg']:.1f}°{late}"
+        # The first step's fall (a fraction of free fall) where the log has it (from the
+        # forty-first session's binary on).
+        first = (f", first step {figures['first_step_fall']:+.2f}"
+                 if "first_step_fall" in figures else "")
+        return f"{figures['drift_m']:.3f} m / {figures['drift_deg']:.1f}°{first}{late}"
     return f"error {figures['error_m']:.3f} m{late}"
 
 

@@ -91,8 +91,9 @@ void run_stress(const StressArgs& args) {
   const std::vector<bullet::StressCase> cases = bullet::select_stress_cases(args.only, args.length);
 
   std::string table =
-      "| case | simulator | finite | lowest point (m) | drift (m / deg) | late speed (m/s) | "
-      "error vs Bullet 240 Hz (m) | ms per frame |\n|---|---|---|---|---|---|---|---|\n";
+      "| case | simulator | finite | lowest point (m) | drift (m / deg) | first-step fall | "
+      "late speed (m/s) | error vs Bullet 240 Hz (m) | ms per frame |\n"
+      "|---|---|---|---|---|---|---|---|---|\n";
   ProgressBar progress("stress", static_cast<long long>(cases.size()));
   std::vector<std::vector<bullet::StressRun>> results;
   for (size_t i = 0; i < cases.size(); ++i) {
@@ -109,9 +110,10 @@ void run_stress(const StressArgs& args) {
         error += fmt::format("; {:.2g} m from the run at the origin", moved);
       }
       table +=
-          fmt::format("| {} | {} | {} | {:.3f} | {} | {:.3f} | {} | {:.2f} |\n", c.name,
+          fmt::format("| {} | {} | {} | {:.3f} | {} | {} | {:.3f} | {} | {:.2f} |\n", c.name,
                       r.simulator, yes_no(r.finite), r.lowest,
                       c.at_rest ? fmt::format("{:.4f} / {:.2f}", r.drift, r.drift_degrees) : "-",
+                      c.at_rest && r.finite ? fmt::format("{:.3f}", r.first_step_fall) : "-",
                       r.late_speed, error, r.milliseconds_per_frame);
     }
   }
@@ -120,7 +122,9 @@ void run_stress(const StressArgs& args) {
   fmt::print(
       "\nlowest point: the lowest vertex over the run, relative to the floor (below -0.05 m is "
       "tunnelling or sinking); drift: largest displacement and rotation of a body started at "
-      "rest; late speed: the fastest body over the run's second half (growth shows energy "
+      "rest; first-step fall: the largest drop of such a body in the first frame, as a fraction "
+      "of free fall from rest (0 holds it, 1 lets it fall; one step, not chaotic); late speed: "
+      "the fastest body over the run's second half (growth shows energy "
       "gained); error: mean translation error against Bullet at 240 Hz (chaotic scenes: for "
       "information only).\n");
   const std::string materials = unfamiliar_materials(cases, models);
@@ -138,8 +142,9 @@ void run_stress(const StressArgs& args) {
         "Cases and metrics: "
         "`bullet_plugin/include/fignet/bullet/stress.h`. The lowest point is that of any vertex "
         "relative to the floor over the whole run: tunnelling or sinking shows as a large "
-        "negative value. Drift is measured for scenes started at rest; the late speed is the "
-        "fastest body over the second half of the run.\n\n{}{}",
+        "negative value. Drift and the first-step fall are measured for scenes started at rest; "
+        "the "
+        "late speed is the fastest body over the second half of the run.\n\n{}{}",
         args.command_line, table, materials);
     write_text_atomically(args.markdown, doc);
     fmt::print("wrote {}\n", args.markdown.string());

@@ -104,6 +104,7 @@ void TrainingLog::write_stress(std::int64_t step, const std::vector<bullet::Stre
         if (cases[i].at_rest) {
           figures["drift_m"] = run.drift;
           figures["drift_deg"] = run.drift_degrees;
+          figures["first_step_fall"] = run.first_step_fall;
         } else {
           figures["error_m"] = run.error;
         }

@@ -347,6 +347,9 @@ std::vector<StressRun> run_stress_case(const StressCase& c, const std::vector<Si
     const Trajectory& t = run.trajectory;
     const double floor = c.scene.floor ? c.scene.floor->height : 0.0;
     run.lowest = std::numeric_limits<double>::infinity();
+    const double free_fall = t.gravity.norm() * t.time_step * t.time_step;
+    const Vec3 down = t.gravity.normalized();
+    if (c.at_rest) run.first_step_fall = -std::numeric_limits<double>::infinity();
     for (size_t o = 0; o < t.objects.size(); ++o) {
       const TrajectoryObject& object = t.objects[o];
       for (int f = 0; f < t.num_frames(); ++f) {
@@ -362,6 +365,10 @@ std::vector<StressRun> run_stress_case(const StressCase& c, const std::vector<Si
               run.late_speed, (pose.position - object.poses[f - 1].position).norm() / t.time_step);
         }
       }
+      if (c.at_rest && run.finite && t.num_frames() > 1 && free_fall > 0.0) {
+        const double drop = (object.poses[1].position - object.poses[0].position).dot(down);
+        run.first_step_fall = std::max(run.first_step_fall, drop / free_fall);
+      }
       if (c.at_rest && run.finite) {
         const Pose& first = object.poses.front();
         const Pose& last = object.poses.back();
@@ -370,6 +377,7 @@ std::vector<StressRun> run_stress_case(const StressCase& c, const std::vector<Si
                                      rotation_angle_degrees(first.orientation, last.orientation));
       }
     }
+    if (!std::isfinite(run.first_step_fall)) run.first_step_fall = 0.0;  // no body, one frame
     if (!runs.empty() && run.finite && runs.front().finite) {
       run.error = rollout_errors(run.trajectory, runs.front().trajectory, 1).mean_translation;
     }

@@ -7,9 +7,11 @@
 #include <utility>
 
 #include "../error_text.h"
+#include "fignet/bullet/fignet_dynamics_world.h"
 #include "fignet/bullet/stress.h"
 #include "fignet/graph/scene.h"
 #include "fignet/io/model_file.h"
+#include "fignet/rollout/predictor.h"
 
 namespace fignet::bullet {
 namespace {
@@ -88,6 +90,45 @@ TEST(Stress, TheMoviCubeStartsWhereBulletRestsIt) {
   EXPECT_NEAR(end.position.z(), start.position.z(), 1e-4);
   EXPECT_LT(runs[0].drift, 5e-3);
   EXPECT_LT(runs[0].drift_degrees, 0.05);
+}
+
+// The first-step fall against physics: a world whose predictor answers free fall drops every
+// resting body by exactly |g|·dt² in the first frame (1), and native Bullet holds the MOVi cube on
+// the floor and the 2-stack, whose upper cube it lifts a little (the stack starts 5 mm apart,
+// Bullet rests two bodies 10 mm apart), so its largest drop is the bottom cube's ~0.
+TEST(Stress, FirstStepFallIsTheFirstFramesDropOverFreeFall) {
+  const std::vector<StressCase> cases =
+      select_stress_cases({"MOVi cube at rest", "stack of 2 MOVi cubes"}, 0.01);
+  ASSERT_EQ(cases.size(), 2u);
+  const double step = 1.0 / 48.0;
+  SolverSettings one_step;
+  one_step.steps_per_frame = 1;
+  const Simulator falls{"free fall", one_step,
+                        [&](btDispatcher* d, btBroadphaseInterface* b, btConstraintSolver* s,
+                            btCollisionConfiguration* c) {
+                          FIGNetWorldOptions options = FIGNetWorldOptions::network_alone();
+                          options.allow_gravity_mismatch = true;
+                          return std::make_unique<FIGNetDynamicsWorld>(
+                              d, b, s, c, std::make_unique<GravityPredictor>(Vec3(0, 0, -10), step),
+                              GraphConfig{}, step, Vec3(0, 0, -10), options);
+                        }};
+  for (const StressCase& c : cases) {
+    const std::vector<StressRun> runs =
+        run_stress_case(c, {Simulator{"Bullet 240 Hz", {}, {}}, falls});
+    ASSERT_TRUE(runs[0].finite && runs[1].finite) << c.name;
+    EXPECT_LT(std::abs(runs[0].first_step_fall), 0.05) << c.name;
+    EXPECT_NEAR(runs[1].first_step_fall, 1.0, 1e-3) << c.name;
+    // The upper cube's own first frame in Bullet: it rises.
+    if (runs[0].trajectory.objects.size() == 2) {
+      const auto& top = runs[0].trajectory.objects[1].poses;
+      EXPECT_GT(top[1].position.z(), top[0].position.z()) << c.name;
+    }
+  }
+  // Not a rest case: no first-step figure.
+  const std::vector<StressCase> drop = select_stress_cases({"canonical"}, 0.01);
+  ASSERT_FALSE(drop.empty());
+  ASSERT_FALSE(drop[0].at_rest);
+  EXPECT_EQ(run_stress_case(drop[0], {Simulator{"Bullet 240 Hz", {}, {}}})[0].first_step_fall, 0.0);
 }
 
 // The pile's other arrangements are other heaps of the same kind: ten bodies each, bodies left

@@ -140,7 +140,8 @@ def test_batch_counts_samples_of_old_logs_by_the_longest_prefix(source_dir, tmp_
 
 def test_stress_lines_get_a_table_of_their_own(source_dir, tmp_path):
     # `fignet train --valid-stress` lines: drift for a case started at rest, error for the others,
-    # the late speed, and a run that went non-finite said so.
+    # the first step's fall where logged (not in logs before it was), the late speed, and a run
+    # that went non-finite said so.
     log = tmp_path / "pile.h5.log.jsonl"
     write_log(log, [(8000, 1.0)])
     with open(log, "a") as out:
@@ -149,7 +150,7 @@ def test_stress_lines_get_a_table_of_their_own(source_dir, tmp_path):
                 "network_alone": {"finite": True, "drift_m": 38.85, "drift_deg": 161.7,
                                   "late_speed_m_s": 4.81, "lowest_m": -0.05},
                 "world": {"finite": True, "drift_m": 0.0123, "drift_deg": 2.0,
-                          "late_speed_m_s": 0.0, "lowest_m": 0.0}},
+                          "first_step_fall": 0.004, "late_speed_m_s": 0.0, "lowest_m": 0.0}},
             "canonical: cube dropped from 1 m": {
                 "network_alone": {"finite": False},
                 "world": {"finite": True, "error_m": 0.109, "late_speed_m_s": 0.0,
@@ -159,7 +160,7 @@ def test_stress_lines_get_a_table_of_their_own(source_dir, tmp_path):
     rows = {cells[3]: cells for cells in table_rows(result.stdout) if len(cells) == 6}
     assert rows["10-object pile at rest"][1:3] == ["1000", "8k"], result.stdout
     assert rows["10-object pile at rest"][4] == "38.850 m / 161.7°, late 4.81 m/s"
-    assert rows["10-object pile at rest"][5] == "0.012 m / 2.0°, late 0.00 m/s"
+    assert rows["10-object pile at rest"][5] == "0.012 m / 2.0°, first step +0.00, late 0.00 m/s"
     assert rows["canonical: cube dropped from 1 m"][4] == "not finite"
     assert rows["canonical: cube dropped from 1 m"][5] == "error 0.109 m, late 0.00 m/s"
 
