@@ -89,6 +89,7 @@ fi
 threads=$(($(nproc) / $#))
 ((threads > 0)) || threads=1
 logs=()
+trap 'rm -f "${logs[@]}"' EXIT # each console is copied beside its run below
 for ((r = 0; r < $#; ++r)); do
   read -r -a words <<<"${@:r+1:1}"
   log="$(mktemp)"
