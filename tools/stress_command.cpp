@@ -124,9 +124,8 @@ void run_stress(const StressArgs& args) {
       "tunnelling or sinking); drift: largest displacement and rotation of a body started at "
       "rest; first-step fall: the largest drop of such a body in the first frame, as a fraction "
       "of free fall from rest (0 holds it, 1 lets it fall; one step, not chaotic); late speed: "
-      "the fastest body over the run's second half (growth shows energy "
-      "gained); error: mean translation error against Bullet at 240 Hz (chaotic scenes: for "
-      "information only).\n");
+      "the fastest body over the run's second half (growth shows energy gained); error: mean "
+      "translation error against Bullet at 240 Hz (chaotic scenes: for information only).\n");
   const std::string materials = unfamiliar_materials(cases, models);
   fmt::print("{}", materials);
   if (!args.markdown.empty()) {
@@ -143,8 +142,7 @@ void run_stress(const StressArgs& args) {
         "`bullet_plugin/include/fignet/bullet/stress.h`. The lowest point is that of any vertex "
         "relative to the floor over the whole run: tunnelling or sinking shows as a large "
         "negative value. Drift and the first-step fall are measured for scenes started at rest; "
-        "the "
-        "late speed is the fastest body over the second half of the run.\n\n{}{}",
+        "the late speed is the fastest body over the second half of the run.\n\n{}{}",
         args.command_line, table, materials);
     write_text_atomically(args.markdown, doc);
     fmt::print("wrote {}\n", args.markdown.string());
