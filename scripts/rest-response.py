@@ -63,17 +63,16 @@ def one_step_response(model, trajectory, sigma, draws, seed=0):
     perturbed by N(0, sigma²) per coordinate, one row per draw, (draws, cubes), metres."""
     history = model.history
     base = np.asarray(fignet.rollout(model, trajectory).positions)[history + 1]
-    vertices, faces = movi_cube_mesh()
+    positions = np.asarray(trajectory.positions)
+    quaternions = np.asarray(trajectory.quaternions)
     rng = np.random.default_rng(seed)
     rows = []
     for _ in range(draws):
         moved = fignet.Trajectory(time_step=trajectory.time_step, gravity=trajectory.gravity)
-        positions = np.asarray(trajectory.positions)
-        quaternions = np.asarray(trajectory.quaternions)
         for k in range(trajectory.num_objects):
             noisy = positions[:, k].copy()
             noisy[:history + 1] += rng.normal(0.0, sigma, (history + 1, 3))
-            moved.add_object(vertices, faces, noisy, quaternions[:, k],
+            moved.add_object(trajectory.vertices(k), trajectory.faces(k), noisy, quaternions[:, k],
                              mass=trajectory.masses[k], friction=trajectory.frictions[k],
                              restitution=trajectory.restitutions[k])
         predicted = np.asarray(fignet.rollout(model, moved).positions)[history + 1]
