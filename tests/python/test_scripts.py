@@ -200,15 +200,21 @@ def test_model_card_names_what_it_lacks(source_dir, tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+def load_rest_response(source_dir):
+    """scripts/rest-response.py as a module (its file name is not an importable name)."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location(
+        "rest_response", source_dir / "scripts" / "rest-response.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def test_rest_response_stacks_movi_cubes_as_trained(source_dir):
     # The stack is built of MOVi-A's own cube (each side split 3×3), not an 8-corner cube the
     # network never saw, and the table has one row per predicted frame and a column per cube.
-    import importlib.util
     import numpy as np
-    spec = importlib.util.spec_from_file_location(
-        "rest_response", source_dir / "scripts" / "rest-response.py")
-    rest_response = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(rest_response)
+    rest_response = load_rest_response(source_dir)
     vertices, faces = rest_response.movi_cube_mesh()
     assert vertices.shape == (56, 3) and faces.shape == (108, 3)
     assert np.allclose(vertices.min(axis=0), -0.7) and np.allclose(vertices.max(axis=0), 0.7)
@@ -224,13 +230,9 @@ def test_rest_response_perturbation_moves_a_falling_cube_in_proportion(source_di
     # --perturb moves only the history the network reads: a cube in free flight, 10 m up, answers
     # a perturbation σ by a few σ (x' = 2x − x₋₁ + a), where a resting stack's tie would answer
     # micrometres; and the table has a row per draw and a column per cube.
-    import importlib.util
     import numpy as np
     import fignet
-    spec = importlib.util.spec_from_file_location(
-        "rest_response", source_dir / "scripts" / "rest-response.py")
-    rest_response = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(rest_response)
+    rest_response = load_rest_response(source_dir)
     model = fignet.load_model(str(source_dir / "models" / "movi-a-small.h5"))
     vertices, faces = rest_response.movi_cube_mesh()
     frames = model.history + 2
