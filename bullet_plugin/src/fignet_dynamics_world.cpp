@@ -17,6 +17,7 @@
 #include "fignet/geometry/triangle_distance.h"
 #include "fignet/graph/contacts.h"
 #include "fignet/graph/graph_builder.h"
+#include "fignet/rollout/free_flight.h"
 #include "fignet/rollout/rollout.h"
 
 namespace fignet::bullet {
@@ -527,19 +528,13 @@ struct FIGNetDynamicsWorld::Impl {
     }
   }
 
-  // Free flight: x_{t+1} = 2x_t − x_{t−1} + g·dt², exact for constant acceleration (applied
-  // forces are already in the history's last velocity), and the last step's rotation again (the
-  // graph config guarantees a history of at least one past pose).
+  // Free flight (rollout/free_flight.h) under the body's own gravity (applied forces are already
+  // in the history's last velocity; the graph config guarantees a history of at least one past
+  // pose).
   Pose free_flight_pose(const btRigidBody& body) const {
     const std::vector<Pose>& poses = states.at(&body).poses;
-    const Pose& current = poses.back();
-    const Pose& previous = poses[poses.size() - 2];
-    Pose next;
-    next.position = 2.0 * current.position - previous.position +
-                    time_step * time_step * from_bt(body.getGravity());
-    next.orientation =
-        (current.orientation * previous.orientation.conjugate() * current.orientation).normalized();
-    return next;
+    return fignet::free_flight_pose(poses[poses.size() - 2], poses.back(),
+                                    time_step * time_step * from_bt(body.getGravity()));
   }
 
   // Next poses of every moving body: the network's for the bodies in contact, free flight for

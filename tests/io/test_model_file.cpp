@@ -29,6 +29,7 @@ class ModelFile : public testing::TempFolderTest {
     config.graph.distance_log_scale = 2e-3;
     config.graph.contact_motion = true;
     config.graph.contact_motion_dead_zone = 7e-4;
+    config.graph.omit_free_flight = true;
     config.min_mass = 1.6;
     config.max_mass = 59.0;
     config.friction = {0.4, 0.8};
@@ -75,6 +76,7 @@ TEST_F(ModelFile, SaveThenLoadIsBitExact) {
   EXPECT_EQ(loaded.config().graph.distance_log_scale, 2e-3);
   EXPECT_TRUE(loaded.config().graph.contact_motion);
   EXPECT_EQ(loaded.config().graph.contact_motion_dead_zone, 7e-4);
+  EXPECT_TRUE(loaded.config().graph.omit_free_flight);
   EXPECT_EQ(loaded.config().min_mass, 1.6);
   EXPECT_EQ(loaded.config().max_mass, 59.0);
   EXPECT_EQ(loaded.config().friction.lowest, 0.4);
@@ -100,14 +102,15 @@ TEST_F(ModelFile, AFileWithoutLaterAttributesReadsWhatOlderFilesWereMadeWith) {
     H5::H5File file(path_.string(), H5F_ACC_RDWR);
     H5::Group config = file.openGroup("config");
     // (Not those that shape the parameters: their files would not load without them.)
-    for (const char* name :
-         {"face_span_limit", "contact_motion_dead_zone", "noise_correction", "random_yaw"}) {
+    for (const char* name : {"face_span_limit", "contact_motion_dead_zone", "omit_free_flight",
+                             "noise_correction", "random_yaw"}) {
       config.removeAttr(name);
     }
   }
   const ModelConfig loaded = load_model(path_).config(), defaults;
   EXPECT_EQ(loaded.graph.face_span_limit, defaults.graph.face_span_limit);
   EXPECT_EQ(loaded.graph.contact_motion_dead_zone, 0.0);
+  EXPECT_FALSE(loaded.graph.omit_free_flight);
   EXPECT_EQ(loaded.noise_correction, defaults.noise_correction);
   EXPECT_FALSE(loaded.random_yaw);
   EXPECT_TRUE(loaded.graph.contact_motion);  // still in the file

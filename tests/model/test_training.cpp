@@ -11,6 +11,7 @@
 #include "fignet/rollout/predictor.h"
 #include "fignet/rollout/rollout.h"
 #include "fignet/train/trainer.h"
+#include "model_fixtures.h"
 #include "trajectory_fixtures.h"
 
 namespace fignet {
@@ -699,22 +700,11 @@ TEST(Model, RolloutThroughAModelIsFiniteAndCountsFaceEdges) {
   EXPECT_GT(face_edges.front(), 0);  // cube–floor face pairs within d_c = 0.1 m
 }
 
-// A model with random weights and normalisers fitted to `scene`, so that neither is at its
-// symmetric initial value.
+// A model of small_model()'s with random weights (model_fixtures.h).
 std::shared_ptr<const Model> random_model(const Scene& scene) {
   ModelConfig config = small_model();
   config.latent_size = 16;
-  Model fresh(config);
-  std::vector<float> params = fresh.parameters();
-  std::mt19937 rng(1);
-  std::normal_distribution<float> noise(0.0f, 0.2f);
-  for (float& p : params) p += noise(rng);
-  Normalizers normalizers = fresh.normalizers();
-  Graph graph;
-  GraphBuilder(config.graph).build(scene, graph);
-  normalizers.mesh_node.accumulate(graph.mesh_nodes.matrix());
-  normalizers.face_edge.accumulate(graph.face_edges.features.matrix());
-  return std::make_shared<const Model>(config, params, normalizers);
+  return testing::random_model(scene, config);
 }
 
 TEST(Model, OutputIsEquivariantToObjectOrder) {

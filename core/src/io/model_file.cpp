@@ -69,6 +69,7 @@ void write_config(H5::Group group, const ModelConfig& c) {
   write_attribute(group, "distance_log_scale", c.graph.distance_log_scale);
   write_attribute(group, "contact_motion", static_cast<long long>(c.graph.contact_motion));
   write_attribute(group, "contact_motion_dead_zone", c.graph.contact_motion_dead_zone);
+  write_attribute(group, "omit_free_flight", static_cast<long long>(c.graph.omit_free_flight));
   write_attribute(group, "noise", std::string(c.noise == NoiseKind::kRigid ? "rigid" : "vertex"));
   write_attribute(group, "noise_correction", c.noise_correction);
   write_attribute(group, "random_yaw", static_cast<long long>(c.random_yaw));
@@ -125,6 +126,7 @@ ModelConfig read_config(const H5::Group& group) {
   c.graph.static_internal_edges = flag("static_internal_edges", true);
   c.graph.log_mass = flag("log_mass", false);
   c.graph.contact_motion = flag("contact_motion", false);
+  c.graph.omit_free_flight = flag("omit_free_flight", false);
   c.graph.face_span_limit = read_double_or(group, "face_span_limit", c.graph.face_span_limit);
   c.graph.velocity_log_scale =
       read_double_or(group, "velocity_log_scale", c.graph.velocity_log_scale);

@@ -82,18 +82,46 @@ const Scene& ModelPredictor::with_fitted_masses(const Scene& scene) {
 }
 
 void ModelPredictor::predict(const Scene& scene, Points& accelerations) {
-  predict_averaged(
-      with_fitted_masses(scene), [&](const Scene& s) { builder_.build(s, graph_); }, accelerations);
+  predict_objects(with_fitted_masses(scene), nullptr, accelerations);
 }
 
 void ModelPredictor::predict_with_candidates(const Scene& scene,
                                              std::span<const ObjectPair> candidates,
                                              Points& accelerations) {
+  predict_objects(with_fitted_masses(scene), &candidates, accelerations);
+}
+
+void ModelPredictor::predict_objects(const Scene& scene,
+                                     const std::span<const ObjectPair>* candidates,
+                                     Points& accelerations) {
+  // A model trained on bodies in contact only sees those; the others fall outside it.
+  const bool omit = model_->config().graph.omit_free_flight;
+  if (omit) free_flight_.split(builder_, scene, candidates, kept_);
+  const std::span<const ObjectPair> pairs =
+      !candidates ? std::span<const ObjectPair>()
+                  : (omit ? free_flight_.kept_candidates() : *candidates);
   // A turn about the vertical moves no object into or out of a pair: the candidates stand.
-  predict_averaged(
-      with_fitted_masses(scene),
-      [&](const Scene& s) { builder_.build_with_candidates(s, candidates, graph_); },
-      accelerations);
+  auto build = [&](const Scene& s) {
+    if (candidates) {
+      builder_.build_with_candidates(s, pairs, graph_);
+    } else {
+      builder_.build(s, graph_);
+    }
+  };
+  if (!omit) {
+    predict_averaged(scene, build, accelerations);
+    return;
+  }
+  if (kept_.objects.empty()) {
+    build(kept_);  // nothing for the network: last_graph() says so
+    kept_accelerations_.resize(0, 3);
+  } else {
+    predict_averaged(kept_, build, kept_accelerations_);
+  }
+  const ModelConfig& config = model_->config();
+  free_flight_.expand_accelerations(scene, kept_accelerations_,
+                                    config.gravity * config.time_step * config.time_step,
+                                    accelerations);
 }
 
 void ModelPredictor::run_network(const Scene& scene, Points& accelerations) {

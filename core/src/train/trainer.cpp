@@ -221,30 +221,56 @@ void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64
 void Trainer::build_graph(int threads, PreparedBatch& batch,
                           const std::function<void(int, int)>& prepare_scenes) const {
   const int scenes = static_cast<int>(batch.scenes.size());
+  // With omit_free_flight the graph holds each scene's objects with a collision edge only: the
+  // others fall by gravity in every rollout of the model, so neither the network nor its loss
+  // sees them.
+  const bool omit = config_.graph.omit_free_flight;
+  if (omit) {
+    batch.free_flight.resize(scenes);
+    batch.kept_scenes.resize(scenes);
+    batch.kept_targets.resize(scenes);
+    batch.kept_resting.resize(batch.scene_resting.size());
+  }
+  auto prepare_and_split = [&](int begin, int end, GraphBuilder& builder) {
+    prepare_scenes(begin, end);
+    if (!omit) return;
+    for (int b = begin; b < end; ++b) {
+      FreeFlightSplit& split = batch.free_flight[b];
+      split.split(builder, batch.scenes[b], nullptr, batch.kept_scenes[b]);
+      split.keep_rows(batch.scenes[b], batch.scene_targets[b], batch.kept_targets[b]);
+      if (batch.scene_resting.empty()) continue;
+      batch.kept_resting[b].clear();
+      for (const int o : split.kept_objects()) {
+        batch.kept_resting[b].push_back(batch.scene_resting[b][o]);
+      }
+    }
+  };
+  const std::vector<Scene>& graph_scenes = omit ? batch.kept_scenes : batch.scenes;
   // Contiguous runs of scenes, one run per thread (the graph is the same however they are cut:
   // each part's nodes and edges are appended in scene order).
   const int parts = std::clamp(std::min(threads, scenes), 1, 64);
   while (static_cast<int>(batch.builders.size()) < parts)
     batch.builders.emplace_back(config_.graph);
   if (parts == 1) {
-    prepare_scenes(0, scenes);
-    batch.builders[0].build(batch.scenes, batch.graph);
+    prepare_and_split(0, scenes, batch.builders[0]);
+    batch.builders[0].build(graph_scenes, batch.graph);
   } else {
     if (static_cast<int>(batch.part_graphs.size()) < parts) batch.part_graphs.resize(parts);
-    const std::span<const Scene> all(batch.scenes);
+    const std::span<const Scene> all(graph_scenes);
     // The first part is built straight into the batch graph, the others beside it.
     detail::parallel_for(parts, parts, detail::Schedule::kContiguous, [&](int i) {
       const int begin = scenes * i / parts, end = scenes * (i + 1) / parts;
-      prepare_scenes(begin, end);
+      prepare_and_split(begin, end, batch.builders[i]);
       batch.builders[i].build(all.subspan(begin, end - begin),
                               i == 0 ? batch.graph : batch.part_graphs[i]);
     });
     for (int i = 1; i < parts; ++i) append_graph(batch.part_graphs[i], batch.graph);
   }
-  gather_targets(batch.graph, batch.scene_targets, batch.targets, batch.in_loss);
+  gather_targets(batch.graph, omit ? batch.kept_targets : batch.scene_targets, batch.targets,
+                 batch.in_loss);
   if (weighs_rest()) {
-    gather_loss_weights(batch.graph, batch.scene_resting, trainer_config_.rest_loss_weight,
-                        batch.loss_weights);
+    gather_loss_weights(batch.graph, omit ? batch.kept_resting : batch.scene_resting,
+                        trainer_config_.rest_loss_weight, batch.loss_weights);
   }
 }
 
@@ -281,11 +307,23 @@ void Trainer::push_forward_current() {
         const int steps = batch.scene_pushed[b];
         if (round >= steps) continue;
         Scene& scene = batch.scenes[b];
-        workspace.accelerations =
-            pushforward_accelerations_.middleRows(scene_first_node[b], scene.num_nodes())
-                .cast<double>();
-        integrate_next_poses(scene, next, workspace);
         const SampleRef& sample = batch.samples[b];
+        if (config_.graph.omit_free_flight) {
+          // The graph held the objects with a collision edge; the others fly free.
+          const Trajectory& trajectory = data_[sample.trajectory];
+          const Points kept_rows =
+              pushforward_accelerations_
+                  .middleRows(scene_first_node[b], batch.kept_scenes[b].num_nodes())
+                  .cast<double>();
+          batch.free_flight[b].expand_accelerations(
+              scene, kept_rows, trajectory.gravity * trajectory.time_step * trajectory.time_step,
+              workspace.accelerations);
+        } else {
+          workspace.accelerations =
+              pushforward_accelerations_.middleRows(scene_first_node[b], scene.num_nodes())
+                  .cast<double>();
+        }
+        integrate_next_poses(scene, next, workspace);
         const int frame = sample.frame - steps + round + 1;
         if (trainer_config_.pushforward_skips_rest) {
           const TrajectoryObject* truth = data_[sample.trajectory].objects.data();
@@ -405,7 +443,14 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
   // each chunk of the batch can take its gradient as soon as its output exists.
   double count = static_cast<double>(std::count(batch.in_loss.begin(), batch.in_loss.end(), 1));
   if (reduce) collective_->sum(std::span<double>(&count, 1));
-  if (count == 0) return 0.0;
+  if (count == 0) {
+    // Nothing to learn from (every body of every scene left out): no step, not the last one's.
+    if (with_gradient) {
+      std::fill(grads_.begin(), grads_.end(), 0.0f);
+      last_gradient_norm_ = 0.0;
+    }
+    return 0.0;
+  }
   // Squared error, or Huber's: quadratic within delta, linear beyond (scaled to match at 0).
   const double delta = trainer_config_.huber_delta;
   auto loss_of = [delta](double error) {

@@ -97,6 +97,8 @@ const std::vector<std::pair<std::string, Field>>& fields() {
       {"contact_motion_dead_zone", plain<double>([](TrainingConfig & c) -> auto& {
          return c.model.graph.contact_motion_dead_zone;
        })},
+      {"omit_free_flight",
+       plain<bool>([](TrainingConfig & c) -> auto& { return c.model.graph.omit_free_flight; })},
       {"noise_std", plain<double>([](TrainingConfig & c) -> auto& { return c.model.noise_std; })},
       {"noise",
        named_enum<NoiseKind>([](TrainingConfig & c) -> auto& { return c.model.noise; },

@@ -55,6 +55,11 @@ struct GraphConfig {
   // rollout, instead of the training noise's few tenths of a millimetre (a rollout from rest
   // starts at exactly 0, where the network had never been taught); 0 keeps u whole.
   double contact_motion_dead_zone = 0.0;
+  // Dynamic objects without a collision edge are left out of the graph, in training and in
+  // prediction, and move by gravity alone (rollout/free_flight.h), as FIGNetDynamicsWorld's free
+  // flight moves them: the network is spent on bodies in contact only. Without it the network
+  // also learns, and is asked, the free flight of bodies that touch nothing.
+  bool omit_free_flight = false;
 
   // Throws ConfigError naming the first invalid field and its value.
   void validate() const;

@@ -10,6 +10,7 @@
 
 #include "fignet/graph/graph_builder.h"
 #include "fignet/model/model.h"
+#include "fignet/rollout/free_flight.h"
 
 namespace fignet {
 
@@ -86,7 +87,9 @@ double mass_fit_factor(const Scene& scene, double min_mass, double max_mass);
 bool familiar_material(const StaticProperties& body, const ModelConfig& config);
 bool familiar_floor(const Floor& floor, const ModelConfig& config);
 
-// Runs a FIGNet model: builds the graph, runs the network, un-normalises. One per thread.
+// Runs a FIGNet model: builds the graph, runs the network, un-normalises. One per thread. A model
+// trained with GraphConfig::omit_free_flight sees only the objects with a collision edge; the
+// others get their free-flight accelerations (free_flight.h).
 class ModelPredictor : public AccelerationPredictor {
  public:
   ModelPredictor(std::shared_ptr<const Model> model, const PredictionOptions& options);
@@ -109,6 +112,10 @@ class ModelPredictor : public AccelerationPredictor {
   void predict_averaged(const Scene& scene, Build&& build, Points& accelerations);
   // The scene the network sees: `scene` itself, or its copy with fitted masses (fit_masses).
   const Scene& with_fitted_masses(const Scene& scene);
+  // predict_averaged on the whole scene, or on its objects with a collision edge only
+  // (omit_free_flight), the others in free flight.
+  void predict_objects(const Scene& scene, const std::span<const ObjectPair>* candidates,
+                       Points& accelerations);
 
   std::shared_ptr<const Model> model_;
   PredictionOptions options_;
@@ -118,6 +125,9 @@ class ModelPredictor : public AccelerationPredictor {
   RowMatrixXf denormalized_;
   Scene turned_, mass_fitted_;
   Points turned_accelerations_, turned_sum_;
+  FreeFlightSplit free_flight_;
+  Scene kept_;  // the scene's objects with a collision edge (omit_free_flight)
+  Points kept_accelerations_;
 };
 
 // Exact free fall: every node accelerates by gravity·dt² (the ballistic baseline without

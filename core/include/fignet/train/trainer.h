@@ -18,6 +18,7 @@
 #include "fignet/model/model.h"
 #include "fignet/model/network_backend.h"
 #include "fignet/nn/adam.h"
+#include "fignet/rollout/free_flight.h"
 #include "fignet/train/collective.h"
 #include "fignet/train/training_batch.h"
 
@@ -159,6 +160,8 @@ class Trainer {
   const std::vector<Scene>& batch_scenes() const { return current().scenes; }
   const std::vector<Points>& batch_targets() const { return current().scene_targets; }
   const std::vector<std::uint8_t>& batch_pushed() const { return current().scene_pushed; }
+  // The graph the last step trained on (with omit_free_flight, of the bodies in contact only).
+  const Graph& batch_graph() const { return current().graph; }
 
   // Checkpoints: state() with model() captures training; restore() continues it exactly.
   TrainerState state() const;
@@ -193,6 +196,12 @@ class Trainer {
     // in scene order.
     std::vector<GraphBuilder> builders;
     std::vector<Graph> part_graphs;
+    // With omit_free_flight, per scene: which of its objects have a collision edge, and the scene,
+    // targets and resting flags of those alone, which the graph is built from.
+    std::vector<FreeFlightSplit> free_flight;
+    std::vector<Scene> kept_scenes;
+    std::vector<Points> kept_targets;
+    std::vector<std::vector<std::uint8_t>> kept_resting;
     Graph graph;
     RowMatrixXf targets;
     std::vector<std::uint8_t> in_loss;

@@ -1,0 +1,85 @@
+#include "fignet/rollout/free_flight.h"
+
+#include "fignet/rollout/rigid_fit.h"
+
+namespace fignet {
+
+Pose free_flight_pose(const Pose& previous, const Pose& current, const Vec3& gravity_step) {
+  Pose next;
+  next.position = 2.0 * current.position - previous.position + gravity_step;
+  next.orientation =
+      (current.orientation * previous.orientation.conjugate() * current.orientation).normalized();
+  return next;
+}
+
+void free_flight_accelerations(const SceneObject& object, const Vec3& gravity_step,
+                               Eigen::Ref<Points> rows) {
+  const Points& rest = object.mesh->vertices();
+  const int steps = object.num_steps();
+  const auto current = object.positions_at(steps - 1);
+  const auto previous = object.positions_at(steps - 2);
+  const Pose next = free_flight_pose(fit_rigid_transform(rest, previous),
+                                     fit_rigid_transform(rest, current), gravity_step);
+  rows = posed_vertices(*object.mesh, next) - 2.0 * current + previous;
+}
+
+void FreeFlightSplit::split(GraphBuilder& builder, const Scene& scene,
+                            const std::span<const ObjectPair>* candidates, Scene& kept) {
+  if (candidates) {
+    builder.find_interacting_objects(scene, *candidates, interacting_);
+  } else {
+    builder.find_interacting_objects(scene, interacting_);
+  }
+  // interacting_ may end with the mesh floor, which builds append whatever the scene holds.
+  const size_t objects = scene.objects.size();
+  kept_index_.assign(objects + 1, -1);
+  kept_objects_.clear();
+  for (size_t o = 0; o < objects; ++o) {
+    if (!interacting_[o]) continue;
+    kept_index_[o] = static_cast<int>(kept_objects_.size());
+    kept_objects_.push_back(static_cast<int>(o));
+  }
+  kept_index_[objects] = static_cast<int>(kept_objects_.size());  // the floor, when a mesh
+  kept.floor = scene.floor;
+  kept.objects.resize(kept_objects_.size());
+  for (size_t k = 0; k < kept_objects_.size(); ++k) {
+    kept.objects[k] = scene.objects[kept_objects_[k]];  // reuses the buffers of a like object
+  }
+  kept_candidates_.clear();
+  if (!candidates) return;
+  for (const ObjectPair& pair : *candidates) {
+    // Out-of-range pairs were rejected by find_interacting_objects.
+    const int a = kept_index_[pair.a], b = kept_index_[pair.b];
+    if (a >= 0 && b >= 0) kept_candidates_.push_back({a, b});
+  }
+}
+
+void FreeFlightSplit::keep_rows(const Scene& scene, const Eigen::Ref<const Points>& rows,
+                                Points& kept_rows) const {
+  Eigen::Index count = 0;
+  for (const int o : kept_objects_) count += scene.objects[o].mesh->num_vertices();
+  kept_rows.resize(count, 3);
+  Eigen::Index row = 0, kept_row = 0;
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    const Eigen::Index v = scene.objects[o].mesh->num_vertices();
+    if (keeps(o)) {
+      kept_rows.middleRows(kept_row, v) = rows.middleRows(row, v);
+      kept_row += v;
+    }
+    row += v;
+  }
+}
+
+void FreeFlightSplit::expand_accelerations(const Scene& scene,
+                                           const Eigen::Ref<const Points>& kept_rows,
+                                           const Vec3& gravity_step, Points& accelerations) const {
+  expand(scene, kept_rows, accelerations, [&](const SceneObject& object, auto rows) {
+    if (object.kinematic) {
+      rows.setZero();
+    } else {
+      free_flight_accelerations(object, gravity_step, rows);
+    }
+  });
+}
+
+}  // namespace fignet
