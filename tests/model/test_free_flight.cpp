@@ -91,6 +91,12 @@ TEST(FreeFlight, PredictorLeavesBodiesWithoutCollisionEdgesToFreeFlight) {
   free_flight_accelerations(scene.objects[0], kGravity * kDt * kDt, free_flight);
   EXPECT_LT((kept_nodes.topRows(flyer) - free_flight).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_GT((all_nodes.topRows(flyer) - free_flight).cwiseAbs().maxCoeff(), 1e-4);
+  // Any model asked to (PredictionOptions::free_flight) does the same.
+  Points asked_nodes;
+  options.free_flight = true;
+  ModelPredictor asked(whole, options);
+  asked.predict(scene, asked_nodes);
+  EXPECT_EQ(asked_nodes, kept_nodes);
   // Its graph holds the resting cube and the floor only.
   EXPECT_EQ(contact_only.last_graph().num_objects(), 2);
   // With the caller's candidate pairs (the floor is object 2), the same.

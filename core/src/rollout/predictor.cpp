@@ -94,8 +94,9 @@ void ModelPredictor::predict_with_candidates(const Scene& scene,
 void ModelPredictor::predict_objects(const Scene& scene,
                                      const std::span<const ObjectPair>* candidates,
                                      Points& accelerations) {
-  // A model trained on bodies in contact only sees those; the others fall outside it.
-  const bool omit = model_->config().graph.omit_free_flight;
+  // A model trained on bodies in contact only sees those, and so does one asked to; the others
+  // fall outside it.
+  const bool omit = options_.free_flight || model_->config().graph.omit_free_flight;
   if (omit) free_flight_.split(builder_, scene, candidates, kept_);
   const std::span<const ObjectPair> pairs =
       !candidates ? std::span<const ObjectPair>()

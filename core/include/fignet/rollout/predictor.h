@@ -56,6 +56,11 @@ struct PredictionOptions {
   // body, and a pile of such bodies scattered tens of metres (docs/bullet-world.md). A scene
   // within the training masses is untouched; so is every scene of a model without them.
   bool fit_masses = true;
+  // Bodies without a collision edge move in free flight (free_flight.h), outside the network, as
+  // FIGNetDynamicsWorld moves them. Always so for a model trained with
+  // GraphConfig::omit_free_flight, which never learned free flight; for another model, what its
+  // rollouts would be in the world's hands (`fignet eval --free-flight`).
+  bool free_flight = false;
 
   // Throws ConfigError naming the field that is out of range.
   void validate() const;
