@@ -73,13 +73,21 @@ void FreeFlightSplit::keep_rows(const Scene& scene, const Eigen::Ref<const Point
 void FreeFlightSplit::expand_accelerations(const Scene& scene,
                                            const Eigen::Ref<const Points>& kept_rows,
                                            const Vec3& gravity_step, Points& accelerations) const {
-  expand(scene, kept_rows, accelerations, [&](const SceneObject& object, auto rows) {
-    if (object.kinematic) {
-      rows.setZero();
+  accelerations.resize(scene.num_nodes(), 3);
+  Eigen::Index row = 0, kept_row = 0;
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    const SceneObject& object = scene.objects[o];
+    const Eigen::Index v = object.mesh->num_vertices();
+    if (keeps(o)) {
+      accelerations.middleRows(row, v) = kept_rows.middleRows(kept_row, v);
+      kept_row += v;
+    } else if (object.kinematic) {
+      accelerations.middleRows(row, v).setZero();
     } else {
-      free_flight_accelerations(object, gravity_step, rows);
+      free_flight_accelerations(object, gravity_step, accelerations.middleRows(row, v));
     }
-  });
+    row += v;
+  }
 }
 
 }  // namespace fignet

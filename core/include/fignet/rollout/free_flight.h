@@ -36,32 +36,14 @@ class FreeFlightSplit {
   // For each object of the kept scene, its index in the scene split last.
   std::span<const int> kept_objects() const { return kept_objects_; }
   std::span<const ObjectPair> kept_candidates() const { return kept_candidates_; }
-  // Whether object o of the scene split last is in kept().
+  // Whether object o of the scene split last is in the kept scene.
   bool keeps(size_t o) const { return kept_index_[o] >= 0; }
 
   // The rows of the kept objects' nodes among per-node rows of the whole scene.
   void keep_rows(const Scene& scene, const Eigen::Ref<const Points>& rows, Points& kept_rows) const;
-  // Per-node rows of the whole scene from rows of the kept scene (one per node of it):
-  // the kept objects' rows copied, the others' from `fill(object, rows)`.
-  template <typename Fill>
-  void expand(const Scene& scene, const Eigen::Ref<const Points>& kept_rows, Points& rows,
-              Fill&& fill) const {
-    rows.resize(scene.num_nodes(), 3);
-    Eigen::Index row = 0, kept_row = 0;
-    for (size_t o = 0; o < scene.objects.size(); ++o) {
-      const SceneObject& object = scene.objects[o];
-      const Eigen::Index v = object.mesh->num_vertices();
-      if (keeps(o)) {
-        rows.middleRows(row, v) = kept_rows.middleRows(kept_row, v);
-        kept_row += v;
-      } else {
-        fill(object, rows.middleRows(row, v));
-      }
-      row += v;
-    }
-  }
-  // expand() with the free-flight accelerations of the objects left out (zero for kinematic ones,
-  // whose rows callers ignore).
+  // Per-node accelerations of the whole scene from those of the kept scene (one row per node of
+  // it): the kept objects' rows copied, the others' their free-flight accelerations (zero for
+  // kinematic ones, whose rows callers ignore).
   void expand_accelerations(const Scene& scene, const Eigen::Ref<const Points>& kept_rows,
                             const Vec3& gravity_step, Points& accelerations) const;
 

@@ -118,7 +118,7 @@ class ModelPredictor : public AccelerationPredictor {
   // The scene the network sees: `scene` itself, or its copy with fitted masses (fit_masses).
   const Scene& with_fitted_masses(const Scene& scene);
   // predict_averaged on the whole scene, or on its objects with a collision edge only
-  // (omit_free_flight), the others in free flight.
+  // (omit_free_flight or PredictionOptions::free_flight), the others in free flight.
   void predict_objects(const Scene& scene, const std::span<const ObjectPair>* candidates,
                        Points& accelerations);
 
