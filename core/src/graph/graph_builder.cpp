@@ -122,17 +122,18 @@ void GraphBuilder::select_pairs(const std::span<const ObjectPair>* candidates) {
 
 void GraphBuilder::find_interacting_objects(const Scene& scene,
                                             std::span<const ObjectPair> candidates,
-                                            std::vector<char>& interacting) {
-  find_interacting(scene, &candidates, interacting);
+                                            std::vector<char>& interacting, SceneContacts* found) {
+  find_interacting(scene, &candidates, interacting, found);
 }
 
-void GraphBuilder::find_interacting_objects(const Scene& scene, std::vector<char>& interacting) {
-  find_interacting(scene, nullptr, interacting);
+void GraphBuilder::find_interacting_objects(const Scene& scene, std::vector<char>& interacting,
+                                            SceneContacts* found) {
+  find_interacting(scene, nullptr, interacting, found);
 }
 
 void GraphBuilder::find_interacting(const Scene& scene,
                                     const std::span<const ObjectPair>* candidates,
-                                    std::vector<char>& interacting) {
+                                    std::vector<char>& interacting, SceneContacts* found) {
   gather_objects(scene, 0);
   posed_.clear();
   for (const SceneObject* object : objects_) posed_.push_back(current_pose(*object));
@@ -140,17 +141,23 @@ void GraphBuilder::find_interacting(const Scene& scene,
   contacts_.update(posed_, !face_collisions);
   select_pairs(candidates);
   interacting.assign(objects_.size(), 0);
+  if (found) {
+    found->faces.clear();
+    found->nodes.clear();
+  }
   // The same search build() makes: a collision edge marks both of its objects.
   if (face_collisions) {
     contacts_.find_face_pairs(pairs_, config_.collision_radius, scene_face_pairs_);
     for (const FacePair& pair : scene_face_pairs_) {
       interacting[pair.object_a] = interacting[pair.object_b] = 1;
     }
+    if (found) found->faces = scene_face_pairs_;
   } else {
     contacts_.find_node_pairs(pairs_, config_.collision_radius, node_pairs_);
     for (const NodePair& pair : node_pairs_) {
       interacting[pair.object_a] = interacting[pair.object_b] = 1;
     }
+    if (found) found->nodes = node_pairs_;
   }
   // An implicit floor has no edges; a node within the radius sees it in its features.
   if (config_.floor != FloorModel::kImplicit || !scene.floor) return;
@@ -162,17 +169,59 @@ void GraphBuilder::find_interacting(const Scene& scene,
   }
 }
 
+void GraphBuilder::validate_contacts(const SceneContacts& contacts, int scene_index) const {
+  const int objects = static_cast<int>(objects_.size());
+  auto check = [&](const char* kind, size_t p, int object_a, int index_a, int object_b, int index_b,
+                   bool faces) {
+    auto element_count = [&](int o) {
+      return faces ? objects_[o]->mesh->num_faces() : objects_[o]->mesh->num_vertices();
+    };
+    if (object_a < 0 || object_b >= objects || object_a >= object_b) {
+      throw ConfigError(fmt::format(
+          "scene {}: given {} pair {} joins objects {} and {}; expected a < b among the scene's {} "
+          "objects",
+          scene_index, kind, p, object_a, object_b, objects));
+    }
+    if (index_a < 0 || index_a >= element_count(object_a) || index_b < 0 ||
+        index_b >= element_count(object_b)) {
+      throw ConfigError(fmt::format(
+          "scene {}: given {} pair {} names {} {} of object {} and {} of object {}, which have {} "
+          "and {}",
+          scene_index, kind, p, faces ? "faces" : "nodes", index_a, object_a, index_b, object_b,
+          element_count(object_a), element_count(object_b)));
+    }
+  };
+  for (size_t p = 0; p < contacts.faces.size(); ++p) {
+    const FacePair& pair = contacts.faces[p];
+    check("face", p, pair.object_a, pair.face_a, pair.object_b, pair.face_b, true);
+  }
+  for (size_t p = 0; p < contacts.nodes.size(); ++p) {
+    const NodePair& pair = contacts.nodes[p];
+    check("node", p, pair.object_a, pair.node_a, pair.object_b, pair.node_b, false);
+  }
+}
+
 void GraphBuilder::build(std::span<const Scene> scenes, Graph& graph) {
-  build_scenes(scenes, nullptr, graph);
+  build_scenes(scenes, nullptr, {}, graph);
 }
 
 void GraphBuilder::build_with_candidates(const Scene& scene, std::span<const ObjectPair> candidates,
                                          Graph& graph) {
-  build_scenes(std::span(&scene, 1), &candidates, graph);
+  build_scenes(std::span(&scene, 1), &candidates, {}, graph);
+}
+
+void GraphBuilder::build_with_contacts(std::span<const Scene> scenes,
+                                       std::span<const SceneContacts> contacts, Graph& graph) {
+  if (contacts.size() != scenes.size()) {
+    throw ConfigError(fmt::format("build_with_contacts: {} scenes but contacts for {}",
+                                  scenes.size(), contacts.size()));
+  }
+  build_scenes(scenes, nullptr, contacts, graph);
 }
 
 void GraphBuilder::build_scenes(std::span<const Scene> scenes,
-                                const std::span<const ObjectPair>* candidates, Graph& graph) {
+                                const std::span<const ObjectPair>* candidates,
+                                std::span<const SceneContacts> contacts, Graph& graph) {
   graph.mesh_nodes.reset(sizes_.mesh_node);
   graph.object_nodes.reset(sizes_.object_node);
   graph.mesh_edges.reset(sizes_.mesh_edge);
@@ -223,15 +272,27 @@ void GraphBuilder::build_scenes(std::span<const Scene> scenes,
       posed_.push_back(current_pose(object));
     }
 
-    // 3. Collision edges between objects within the collision radius.
-    contacts_.update(posed_, !face_collisions);
-    select_pairs(candidates);
+    // 3. Collision edges between objects within the collision radius: searched, or as given.
+    const std::vector<FacePair>* scene_faces = &scene_face_pairs_;
+    const std::vector<NodePair>* scene_nodes = &node_pairs_;
+    if (contacts.empty()) {
+      contacts_.update(posed_, !face_collisions);
+      select_pairs(candidates);
+      if (face_collisions) {
+        contacts_.find_face_pairs(pairs_, config_.collision_radius, scene_face_pairs_);
+      } else {
+        contacts_.find_node_pairs(pairs_, config_.collision_radius, node_pairs_);
+      }
+    } else {
+      validate_contacts(contacts[s], static_cast<int>(s));
+      scene_faces = &contacts[s].faces;
+      scene_nodes = &contacts[s].nodes;
+    }
     auto first_node = [&](int local_object) {
       return graph.object_first_node[first_object + local_object];
     };
     if (face_collisions) {
-      contacts_.find_face_pairs(pairs_, config_.collision_radius, scene_face_pairs_);
-      for (FacePair pair : scene_face_pairs_) {
+      for (FacePair pair : *scene_faces) {
         detail::append_face_edges(config_, pair, posed_[pair.object_a], posed_[pair.object_b],
                                   first_node(pair.object_a), first_node(pair.object_b),
                                   graph.face_edges);
@@ -240,8 +301,7 @@ void GraphBuilder::build_scenes(std::span<const Scene> scenes,
         face_pairs_.push_back(pair);
       }
     } else {
-      contacts_.find_node_pairs(pairs_, config_.collision_radius, node_pairs_);
-      for (const NodePair& pair : node_pairs_) {
+      for (const NodePair& pair : *scene_nodes) {
         detail::append_world_edges(pair, posed_[pair.object_a], posed_[pair.object_b],
                                    first_node(pair.object_a), first_node(pair.object_b),
                                    graph.world_edges);

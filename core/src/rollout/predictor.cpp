@@ -97,13 +97,17 @@ void ModelPredictor::predict_objects(const Scene& scene,
   // A model trained on bodies in contact only sees those, and so does one asked to; the others
   // fall outside it.
   const bool omit = options_.free_flight || model_->config().graph.omit_free_flight;
-  if (omit) free_flight_.split(builder_, scene, candidates, kept_);
+  if (omit) free_flight_.split(builder_, scene, candidates, kept_, kept_contacts_);
   const std::span<const ObjectPair> pairs =
       !candidates ? std::span<const ObjectPair>()
                   : (omit ? free_flight_.kept_candidates() : *candidates);
-  // A turn about the vertical moves no object into or out of a pair: the candidates stand.
+  // A turn about the vertical moves no object into or out of a pair: the candidates stand. The
+  // kept scene itself is built from the split's search; a turned copy meets the floor's faces
+  // elsewhere and is searched.
   auto build = [&](const Scene& s) {
-    if (candidates) {
+    if (&s == &kept_) {
+      builder_.build_with_contacts(std::span(&kept_, 1), std::span(&kept_contacts_, 1), graph_);
+    } else if (candidates) {
       builder_.build_with_candidates(s, pairs, graph_);
     } else {
       builder_.build(s, graph_);

@@ -228,6 +228,7 @@ void Trainer::build_graph(int threads, PreparedBatch& batch,
   if (omit) {
     batch.free_flight.resize(scenes);
     batch.kept_scenes.resize(scenes);
+    batch.kept_contacts.resize(scenes);
     batch.kept_targets.resize(scenes);
     batch.kept_resting.resize(batch.scene_resting.size());
   }
@@ -236,7 +237,7 @@ void Trainer::build_graph(int threads, PreparedBatch& batch,
     if (!omit) return;
     for (int b = begin; b < end; ++b) {
       FreeFlightSplit& split = batch.free_flight[b];
-      split.split(builder, batch.scenes[b], nullptr, batch.kept_scenes[b]);
+      split.split(builder, batch.scenes[b], nullptr, batch.kept_scenes[b], batch.kept_contacts[b]);
       split.keep_rows(batch.scenes[b], batch.scene_targets[b], batch.kept_targets[b]);
       if (batch.scene_resting.empty()) continue;
       batch.kept_resting[b].clear();
@@ -246,6 +247,15 @@ void Trainer::build_graph(int threads, PreparedBatch& batch,
     }
   };
   const std::vector<Scene>& graph_scenes = omit ? batch.kept_scenes : batch.scenes;
+  auto build_part = [&](int begin, int end, GraphBuilder& builder, Graph& graph) {
+    const std::span<const Scene> part = std::span(graph_scenes).subspan(begin, end - begin);
+    if (omit) {
+      builder.build_with_contacts(part, std::span(batch.kept_contacts).subspan(begin, end - begin),
+                                  graph);
+    } else {
+      builder.build(part, graph);
+    }
+  };
   // Contiguous runs of scenes, one run per thread (the graph is the same however they are cut:
   // each part's nodes and edges are appended in scene order).
   const int parts = std::clamp(std::min(threads, scenes), 1, 64);
@@ -253,16 +263,14 @@ void Trainer::build_graph(int threads, PreparedBatch& batch,
     batch.builders.emplace_back(config_.graph);
   if (parts == 1) {
     prepare_and_split(0, scenes, batch.builders[0]);
-    batch.builders[0].build(graph_scenes, batch.graph);
+    build_part(0, scenes, batch.builders[0], batch.graph);
   } else {
     if (static_cast<int>(batch.part_graphs.size()) < parts) batch.part_graphs.resize(parts);
-    const std::span<const Scene> all(graph_scenes);
     // The first part is built straight into the batch graph, the others beside it.
     detail::parallel_for(parts, parts, detail::Schedule::kContiguous, [&](int i) {
       const int begin = scenes * i / parts, end = scenes * (i + 1) / parts;
       prepare_and_split(begin, end, batch.builders[i]);
-      batch.builders[i].build(all.subspan(begin, end - begin),
-                              i == 0 ? batch.graph : batch.part_graphs[i]);
+      build_part(begin, end, batch.builders[i], i == 0 ? batch.graph : batch.part_graphs[i]);
     });
     for (int i = 1; i < parts; ++i) append_graph(batch.part_graphs[i], batch.graph);
   }

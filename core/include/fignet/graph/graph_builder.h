@@ -18,6 +18,13 @@ namespace fignet {
 // triangles facing +z.
 TriangleMesh make_floor_mesh(double half_extent, int segments);
 
+// The collision pairs a contact search found in one scene: face pairs (CollisionEdges::kFaceFace)
+// or node pairs (kNodeNode), with object indices into the scene's objects, the mesh floor last.
+struct SceneContacts {
+  std::vector<FacePair> faces;
+  std::vector<NodePair> nodes;
+};
+
 class GraphBuilder {
  public:
   explicit GraphBuilder(const GraphConfig& config);
@@ -36,21 +43,31 @@ class GraphBuilder {
   void build_with_candidates(const Scene& scene, std::span<const ObjectPair> candidates,
                              Graph& graph);
 
+  // Builds `scenes` with each one's collision pairs given (contacts[s] for scenes[s]) instead of
+  // searched: for scenes cut from searched ones (FreeFlightSplit), whose search stands. Throws
+  // ConfigError when the counts differ or a pair names an object, face or node a scene lacks.
+  void build_with_contacts(std::span<const Scene> scenes, std::span<const SceneContacts> contacts,
+                           Graph& graph);
+
   // Which objects build_with_candidates(scene, candidates) would give a collision edge (face–face
   // or node–node), or, with an implicit floor, would place within the collision radius of it: one
   // flag per object, the mesh floor last when there is one. The network's prediction for an object
   // without any depends on nothing outside it (a physics engine can advance it itself).
+  // With `found`, the search's collision pairs too, which build_with_contacts can reuse.
   void find_interacting_objects(const Scene& scene, std::span<const ObjectPair> candidates,
-                                std::vector<char>& interacting);
+                                std::vector<char>& interacting, SceneContacts* found = nullptr);
   // The same with the pairs build(scene) would examine (the builder's own sweep).
-  void find_interacting_objects(const Scene& scene, std::vector<char>& interacting);
+  void find_interacting_objects(const Scene& scene, std::vector<char>& interacting,
+                                SceneContacts* found = nullptr);
 
   // The face pairs found by the last build, with object indices into the graph's objects.
   std::span<const FacePair> face_pairs() const { return face_pairs_; }
 
  private:
+  // Searches each scene's collision pairs (among `candidates` when given) unless `contacts` gives
+  // them.
   void build_scenes(std::span<const Scene> scenes, const std::span<const ObjectPair>* candidates,
-                    Graph& graph);
+                    std::span<const SceneContacts> contacts, Graph& graph);
   void validate_scene(const Scene& scene, int scene_index) const;
   // The scene's objects into objects_ (validated; the mesh floor appended).
   void gather_objects(const Scene& scene, int scene_index);
@@ -58,7 +75,9 @@ class GraphBuilder {
   // The pairs to search into pairs_: the caller's (checked), or the builder's own sweep.
   void select_pairs(const std::span<const ObjectPair>* candidates);
   void find_interacting(const Scene& scene, const std::span<const ObjectPair>* candidates,
-                        std::vector<char>& interacting);
+                        std::vector<char>& interacting, SceneContacts* found);
+  // Throws unless every pair of `contacts` names objects, faces and nodes of objects_.
+  void validate_contacts(const SceneContacts& contacts, int scene_index) const;
   const SceneObject& floor_object(const Scene& scene, int scene_index);
 
   GraphConfig config_;

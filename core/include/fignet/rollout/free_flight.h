@@ -30,9 +30,12 @@ class FreeFlightSplit {
  public:
   // Finds the objects of `scene` with a collision edge (GraphBuilder::find_interacting_objects,
   // with the caller's candidate pairs when given) and copies them, in order, into `kept` (whose
-  // buffers are reused); the floor stays. Candidate pairs are renumbered into kept_candidates().
+  // buffers are reused); the floor stays. The search's collision pairs, renumbered, go into
+  // `kept_contacts`: GraphBuilder::build_with_contacts builds `kept` from them without searching
+  // again. Candidate pairs are renumbered into kept_candidates().
   void split(GraphBuilder& builder, const Scene& scene,
-             const std::span<const ObjectPair>* candidates, Scene& kept);
+             const std::span<const ObjectPair>* candidates, Scene& kept,
+             SceneContacts& kept_contacts);
   // For each object of the kept scene, its index in the scene split last.
   std::span<const int> kept_objects() const { return kept_objects_; }
   std::span<const ObjectPair> kept_candidates() const { return kept_candidates_; }
@@ -49,6 +52,7 @@ class FreeFlightSplit {
 
  private:
   std::vector<char> interacting_;
+  SceneContacts found_;
   std::vector<int> kept_index_, kept_objects_;
   std::vector<ObjectPair> kept_candidates_;
 };

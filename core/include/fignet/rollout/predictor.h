@@ -131,7 +131,8 @@ class ModelPredictor : public AccelerationPredictor {
   Scene turned_, mass_fitted_;
   Points turned_accelerations_, turned_sum_;
   FreeFlightSplit free_flight_;
-  Scene kept_;  // the scene's objects with a collision edge (omit_free_flight)
+  Scene kept_;                   // the scene's objects with a collision edge (omit_free_flight)
+  SceneContacts kept_contacts_;  // and their collision pairs, as the split's search found them
   Points kept_accelerations_;
 };
 

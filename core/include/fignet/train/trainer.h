@@ -197,9 +197,11 @@ class Trainer {
     std::vector<GraphBuilder> builders;
     std::vector<Graph> part_graphs;
     // With omit_free_flight, per scene: which of its objects have a collision edge, and the scene,
-    // targets and resting flags of those alone, which the graph is built from.
+    // targets and resting flags of those alone, which the graph is built from, with the split's
+    // collision pairs (no second search).
     std::vector<FreeFlightSplit> free_flight;
     std::vector<Scene> kept_scenes;
+    std::vector<SceneContacts> kept_contacts;
     std::vector<Points> kept_targets;
     std::vector<std::vector<std::uint8_t>> kept_resting;
     Graph graph;
