@@ -85,7 +85,7 @@ void add_generate_command(CLI::App& app) {
       ->check(CLI::Range(0, 100'000))
       ->capture_default_str();
   cmd->add_option("--min-objects", args->options.scene.min_objects,
-                  "Fewest tossed objects per scene (at least 1 without --stacks)")
+                  "Fewest tossed objects per scene (at least 1 without --stacks or --piles)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   cmd->add_option("--max-objects", args->options.scene.max_objects, "Most tossed objects per scene")
@@ -108,6 +108,24 @@ void add_generate_command(CLI::App& app) {
                   "Most levels per stack (with --stacks); the levels are uniform in the range")
       ->needs(stacks)
       ->check(CLI::Range(1, bullet::kMaxStackLevels))
+      ->capture_default_str();
+  CLI::Option* piles =
+      cmd->add_option("--piles", args->options.scene.piles,
+                      "Piles of the preset's objects dropped in a column and settled by Bullet "
+                      "before the first frame, still on the floor of each movi-a or movi-b "
+                      "scene, placed after the stacks and before the tossed objects (--min-objects "
+                      "may then be 0); 0: none")
+          ->check(CLI::Range(0, 20))
+          ->capture_default_str();
+  cmd->add_option("--min-pile-objects", args->options.scene.min_pile_objects,
+                  "Fewest objects per pile (with --piles)")
+      ->needs(piles)
+      ->check(CLI::Range(1, bullet::kMaxPileObjects))
+      ->capture_default_str();
+  cmd->add_option("--max-pile-objects", args->options.scene.max_pile_objects,
+                  "Most objects per pile (with --piles); the counts are uniform in the range")
+      ->needs(piles)
+      ->check(CLI::Range(1, bullet::kMaxPileObjects))
       ->capture_default_str();
   cmd->add_option("--assets", args->options.scene.assets,
                   "Folder of mesh files (OBJ, STL, PLY, glTF, OFF): extra objects for movi-b, the "

@@ -64,7 +64,10 @@ DatasetInfo dataset_info(const GenerateOptions& options, std::string generator_v
           .seed = options.seed,
           .stacks = options.scene.stacks,
           .min_stack_levels = options.scene.min_stack_levels,
-          .max_stack_levels = options.scene.max_stack_levels};
+          .max_stack_levels = options.scene.max_stack_levels,
+          .piles = options.scene.piles,
+          .min_pile_objects = options.scene.min_pile_objects,
+          .max_pile_objects = options.scene.max_pile_objects};
 }
 
 }  // namespace fignet::bullet

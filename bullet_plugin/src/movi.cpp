@@ -9,6 +9,7 @@
 #include <numbers>
 #include <random>
 
+#include "fignet/bullet/bullet_simulation.h"
 #include "fignet/bullet/mesh_file.h"
 #include "fignet/error.h"
 #include "fignet/geometry/shapes.h"
@@ -161,6 +162,96 @@ void add_stacks(const MoviOptions& options, bool movi_a, std::uint64_t seed, Sce
   }
 }
 
+// Inner half-width of the bin a pile is settled in first: two of the largest MOVi-A cubes side by
+// side.
+constexpr double kPileBinHalfWidth = 2.9;
+
+// options.piles piles of the preset's objects, dropped in a column and settled by Bullet, at rest
+// on spec's floor. Their own generator keeps the tossed objects' draws as MOVi's; `placed`
+// receives their bounding spheres so later bodies spawn clear of them.
+void add_piles(const MoviOptions& options, bool movi_a, const std::vector<Source>& sources,
+               std::uint64_t seed, SceneSpec& spec, BoundingSpheres& placed) {
+  std::mt19937_64 rng(seed ^ 0x5069'6c65'7300'0001ULL);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal;
+  const int source_count = static_cast<int>(sources.size());
+  auto bounding_radius = [](const BodySpec& body) {
+    return body.mesh->vertices().rowwise().norm().maxCoeff();
+  };
+  for (int p = 0; p < options.piles; ++p) {
+    const int span = options.max_pile_objects - options.min_pile_objects;
+    const int count =
+        options.min_pile_objects + std::min(span, static_cast<int>(unit(rng) * (span + 1)));
+    // A column around the vertical axis through the origin, each body clear above the last, in
+    // a scene of its own with the same floor and physics.
+    SceneSpec drop;
+    drop.floor = spec.floor;
+    drop.gravity = spec.gravity;
+    drop.physics_step = spec.physics_step;
+    drop.steps_per_frame = spec.steps_per_frame;
+    drop.collision_margin = spec.collision_margin;
+    double height = spec.floor->height;
+    for (int i = 0; i < count; ++i) {
+      const Source& source = sources[static_cast<int>(unit(rng) * source_count) % source_count];
+      const double scale = movi_a ? (unit(rng) < 0.5 ? 0.7 : 1.4) : 0.7 + 0.7 * unit(rng);
+      const Material& material = unit(rng) < 0.5 ? kMetal : kRubber;
+      BodySpec body = make_object(source, options.mesh_import, material, scale);
+      const double radius = bounding_radius(body);
+      body.pose.orientation =
+          Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
+      body.pose.position =
+          Vec3(0.6 * unit(rng) - 0.3, 0.6 * unit(rng) - 0.3, height + radius + 0.05);
+      height += 2.0 * radius + 0.05;
+      drop.bodies.push_back(std::move(body));
+    }
+    // Settled in two runs of Bullet: first inside a square bin (four still walls), where the
+    // column falls into a heap instead of scattering, then without the bin, where the heap slumps
+    // to where it stands; each run starts still from the last one's poses.
+    const int settle_frames = static_cast<int>(std::lround(3.0 / drop.frame_step()));
+    auto settle = [&](const std::vector<BodySpec>& walls) {
+      SceneSpec run = drop;
+      run.bodies.insert(run.bodies.end(), walls.begin(), walls.end());
+      BulletSimulation simulation(run);
+      for (int f = 0; f < settle_frames; ++f) simulation.step_frame();
+      for (size_t i = 0; i < drop.bodies.size(); ++i) {
+        drop.bodies[i].pose = simulation.pose(static_cast<int>(i));
+        drop.bodies[i].linear_velocity = drop.bodies[i].angular_velocity = Vec3::Zero();
+      }
+    };
+    std::vector<BodySpec> bin;
+    for (int side = 0; side < 4; ++side) {
+      const bool along_x = side < 2;
+      const double sign = side % 2 == 0 ? 1.0 : -1.0;
+      // As tall as the column, so nothing bounces out.
+      const Vec3 half = along_x ? Vec3(0.25, kPileBinHalfWidth + 0.5, 0.5 * height + 1.0)
+                                : Vec3(kPileBinHalfWidth + 0.5, 0.25, 0.5 * height + 1.0);
+      BodySpec wall = make_body(make_box(half), 1.0, 0.5, 0.3);
+      wall.kinematic = true;
+      wall.properties.mass = 0.0;
+      wall.pose.position = along_x ? Vec3(sign * (kPileBinHalfWidth + 0.25), 0.0, half.z())
+                                   : Vec3(0.0, sign * (kPileBinHalfWidth + 0.25), half.z());
+      bin.push_back(std::move(wall));
+    }
+    settle(bin);
+    settle({});
+    // A spot where no body's bounding sphere meets an earlier body's.
+    for (int attempt = 0; attempt < 100; ++attempt) {
+      const Vec3 spot(-4 + 8 * unit(rng), -4 + 8 * unit(rng), 0.0);
+      bool clear = true;
+      for (const BodySpec& body : drop.bodies) {
+        clear = clear && clear_of(placed, body.pose.position + spot, bounding_radius(body));
+      }
+      if (!clear) continue;
+      for (BodySpec& body : drop.bodies) {
+        body.pose.position += spot;
+        placed.emplace_back(body.pose.position, bounding_radius(body));
+        spec.bodies.push_back(std::move(body));
+      }
+      break;
+    }
+  }
+}
+
 }  // namespace
 
 const std::vector<std::string>& movi_presets() {
@@ -178,6 +269,7 @@ int frames_or_default(const MoviOptions& options, int preset_frames) {
 SceneSpec sample_scene(const MoviOptions& options, std::uint64_t seed) {
   if (options.preset == "pushing") {
     if (options.stacks != 0) throw ConfigError("stacks need preset movi-a or movi-b, not pushing");
+    if (options.piles != 0) throw ConfigError("piles need preset movi-a or movi-b, not pushing");
     return sample_pushing_scene(options, seed);
   }
   return sample_movi_scene(options, seed);
@@ -189,20 +281,27 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
     throw ConfigError(fmt::format("unknown scene preset '{}'; available: {}", options.preset,
                                   fmt::join(movi_presets(), ", ")));
   }
-  // Tossed objects: at least one, unless stacks stand in the scene.
-  const int fewest = options.stacks > 0 ? 0 : 1;
+  // Tossed objects: at least one, unless stacks or piles stand in the scene.
+  const int fewest = options.stacks > 0 || options.piles > 0 ? 0 : 1;
   if (options.min_objects < fewest || options.max_objects < options.min_objects) {
     throw ConfigError(fmt::format("objects range {}..{} is empty or below {}", options.min_objects,
                                   options.max_objects, fewest));
   }
-  if (options.stacks < 0) {
-    throw ConfigError(fmt::format("stacks = {} (must be >= 0)", options.stacks));
-  }
-  if (options.min_stack_levels < 1 || options.max_stack_levels < options.min_stack_levels ||
-      options.max_stack_levels > kMaxStackLevels) {
-    throw ConfigError(fmt::format("stack levels {}..{}: need 1 <= min <= max <= {}",
-                                  options.min_stack_levels, options.max_stack_levels,
-                                  kMaxStackLevels));
+  // A count of things per scene and the range of their sizes.
+  auto check_counts = [](const char* things, int count, const char* sizes, int low, int high,
+                         int most) {
+    if (count < 0) throw ConfigError(fmt::format("{} = {} (must be >= 0)", things, count));
+    if (low < 1 || high < low || high > most) {
+      throw ConfigError(
+          fmt::format("{} {}..{}: need 1 <= min <= max <= {}", sizes, low, high, most));
+    }
+  };
+  check_counts("stacks", options.stacks, "stack levels", options.min_stack_levels,
+               options.max_stack_levels, kMaxStackLevels);
+  check_counts("piles", options.piles, "pile objects", options.min_pile_objects,
+               options.max_pile_objects, kMaxPileObjects);
+  if (options.piles > 0 && movi_c) {
+    throw ConfigError("piles need preset movi-a or movi-b, not movi-c");
   }
   if (options.stacks > 0 && movi_c) {
     throw ConfigError("stacks need cubes and cylinders: preset movi-a or movi-b, not movi-c");
@@ -240,6 +339,7 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
                     static_cast<int>(unit(rng) * (options.max_objects - options.min_objects + 1));
   BoundingSpheres spheres;  // placed bodies' bounding spheres
   if (options.stacks > 0) add_stacks(options, movi_a, seed, spec, spheres);
+  if (options.piles > 0) add_piles(options, movi_a, sources, seed, spec, spheres);
   for (int i = 0; i < std::min(count, options.max_objects); ++i) {
     const Source& source = sources[static_cast<int>(unit(rng) * source_count) % source_count];
     // Scale: MOVi-A 0.7 or 1.4, MOVi-B U(0.7, 1.4), MOVi-C U(0.75, 3.0).

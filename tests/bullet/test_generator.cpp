@@ -298,6 +298,71 @@ TEST(Generator, TossedObjectsSpawnClearOfTheStacks) {
   }
 }
 
+MoviOptions piles_only(int piles) {
+  MoviOptions options;
+  options.piles = piles;
+  options.min_pile_objects = 5;
+  options.max_pile_objects = 6;
+  options.min_objects = options.max_objects = 0;
+  return options;
+}
+
+// Piles start settled: every body still and none below the floor; in some scenes bodies lie on
+// others (their lowest point well above the floor). Through a whole trajectory in Bullet most
+// bodies stay where they lay; round ones may roll off (Bullet has no rolling friction here), and
+// what lay on them with them. A column dropped without settling would fall metres instead.
+TEST(Generator, PilesStartSettledWithBodiesOnOneAnother) {
+  GenerateOptions options;
+  options.scene = piles_only(2);
+  options.count = 6;
+  options.seed = 11;
+  options.threads = 2;
+  int scenes_with_a_body_on_another = 0, bodies = 0, bodies_still = 0;
+  for (std::uint64_t i = 0; i < 6; ++i) {
+    const SceneSpec spec = sample_movi_scene(options.scene, trajectory_seed(options.seed, i));
+    EXPECT_GE(spec.bodies.size(), 10u) << "scene " << i;  // a pile left out would leave fewer
+    bool on_another = false;
+    for (const BodySpec& body : spec.bodies) {
+      EXPECT_EQ(body.linear_velocity, Vec3::Zero());
+      EXPECT_EQ(body.angular_velocity, Vec3::Zero());
+      EXPECT_GT(lowest(body), spec.floor->height - 0.01);
+      on_another = on_another || lowest(body) > spec.floor->height + 0.05;
+    }
+    scenes_with_a_body_on_another += on_another;
+  }
+  EXPECT_GE(scenes_with_a_body_on_another, 2);
+  for (const Trajectory& t : generate_dataset(options)) {
+    for (const TrajectoryObject& object : t.objects) {
+      ++bodies;
+      bodies_still += (object.poses.back().position - object.poses.front().position).norm() < 0.02;
+      EXPECT_LT((object.poses.back().position - object.poses.front().position).norm(), 2.0);
+    }
+  }
+  EXPECT_GE(bodies_still, bodies / 2) << bodies_still << " of " << bodies;
+}
+
+// Tossed objects spawn clear of the piles: their bounding spheres meet no pile body's.
+TEST(Generator, TossedObjectsSpawnClearOfThePiles) {
+  for (std::uint64_t seed = 0; seed < 10; ++seed) {
+    MoviOptions options;
+    options.piles = 1;
+    const SceneSpec spec = sample_movi_scene(options, trajectory_seed(5, seed));
+    int tossed = 0;
+    for (const BodySpec& body : spec.bodies) {
+      if (body.linear_velocity == Vec3::Zero()) continue;
+      ++tossed;
+      const double radius = body.mesh->vertices().rowwise().norm().maxCoeff();
+      for (const BodySpec& pile : spec.bodies) {
+        if (pile.linear_velocity != Vec3::Zero()) continue;
+        const double pile_radius = pile.mesh->vertices().rowwise().norm().maxCoeff();
+        EXPECT_GT((body.pose.position - pile.pose.position).norm(), radius + pile_radius)
+            << "seed " << seed;
+      }
+    }
+    EXPECT_GE(tossed, 1) << "seed " << seed;
+  }
+}
+
 TEST(Generator, DatasetInfoRecordsEveryOptionThatShapesTheScenes) {
   GenerateOptions options = small_options(1);
   options.scene.preset = "movi-b";
@@ -305,7 +370,10 @@ TEST(Generator, DatasetInfoRecordsEveryOptionThatShapesTheScenes) {
   options.scene.stacks = 2;
   options.scene.min_stack_levels = 4;
   options.scene.max_stack_levels = 6;
-  EXPECT_EQ(dataset_info(options, "9.8.7"), (DatasetInfo{"movi-b", "9.8.7", 19, 2, 4, 6}));
+  options.scene.piles = 3;
+  options.scene.min_pile_objects = 2;
+  options.scene.max_pile_objects = 9;
+  EXPECT_EQ(dataset_info(options, "9.8.7"), (DatasetInfo{"movi-b", "9.8.7", 19, 2, 4, 6, 3, 2, 9}));
 }
 
 TEST(Generator, BadOptionsAreConfigErrors) {
@@ -325,20 +393,36 @@ TEST(Generator, BadOptionsAreConfigErrors) {
   EXPECT_THROW(generate_dataset(options), ConfigError);
   options.scene.stacks = -1;
   EXPECT_THROW(generate_dataset(options), ConfigError);
-  for (auto [fewest, most] :
-       {std::pair(0, 3), std::pair(4, 3), std::pair(1, kMaxStackLevels + 1)}) {
-    options = small_options(1);
-    options.scene.stacks = 1;
-    options.scene.min_stack_levels = fewest;
-    options.scene.max_stack_levels = most;
-    EXPECT_THROW(generate_dataset(options), ConfigError) << fewest << ".." << most;
-  }
+  // Ranges of stack levels and of pile objects: empty, below 1, above the most.
+  auto expect_bad_ranges = [](int most, auto set) {
+    for (auto [fewest, largest] : {std::pair(0, 3), std::pair(4, 3), std::pair(1, most + 1)}) {
+      GenerateOptions bad = small_options(1);
+      set(bad.scene, fewest, largest);
+      EXPECT_THROW(generate_dataset(bad), ConfigError) << fewest << ".." << largest;
+    }
+  };
+  expect_bad_ranges(kMaxStackLevels, [](MoviOptions& scene, int fewest, int most) {
+    scene.stacks = 1;
+    scene.min_stack_levels = fewest;
+    scene.max_stack_levels = most;
+  });
+  expect_bad_ranges(kMaxPileObjects, [](MoviOptions& scene, int fewest, int most) {
+    scene.piles = 1;
+    scene.min_pile_objects = fewest;
+    scene.max_pile_objects = most;
+  });
   for (const char* preset : {"movi-c", "pushing"}) {
     options = small_options(1);
     options.scene.preset = preset;
     options.scene.stacks = 1;
     EXPECT_THROW(generate_dataset(options), ConfigError) << preset;
+    options.scene.stacks = 0;
+    options.scene.piles = 1;
+    EXPECT_THROW(generate_dataset(options), ConfigError) << preset;
   }
+  options = small_options(1);
+  options.scene.piles = -1;
+  EXPECT_THROW(generate_dataset(options), ConfigError);
 }
 
 }  // namespace

@@ -56,7 +56,7 @@ class TrajectoryFile : public testing::TempFolderTest {
 
 TEST_F(TrajectoryFile, WriteThenReadRoundTripsExactly) {
   const auto data = make_data(3);
-  const DatasetInfo written{"movi-a", "0.1.0", 7, 2, 3, 5};
+  const DatasetInfo written{"movi-a", "0.1.0", 7, 2, 3, 5, 1, 4, 8};
   write_trajectories(dir_ / "set.h5", data, written);
   DatasetInfo info;
   const auto read = read_trajectories(dir_ / "set.h5", &info);
@@ -83,15 +83,17 @@ TEST_F(TrajectoryFile, WriteThenReadRoundTripsExactly) {
       EXPECT_EQ(a.linear_velocities, b.linear_velocities);
     }
   }
-  // A file from before stacks and their levels were options reads as the preset's scenes, 1-3.
+  // A file from before stacks, their levels and piles were options reads as the preset's scenes:
+  // no stacks (1-3 levels when asked) and no piles (3-6 objects when asked).
   {
     H5::H5File file(std::string(dir_ / "set.h5"), H5F_ACC_RDWR);
     H5::Group root = file.openGroup("/");
-    for (const char* name : {"stacks", "min_stack_levels", "max_stack_levels"})
+    for (const char* name : {"stacks", "min_stack_levels", "max_stack_levels", "piles",
+                             "min_pile_objects", "max_pile_objects"})
       root.removeAttr(name);
   }
   read_trajectories(dir_ / "set.h5", &info);
-  EXPECT_EQ(info, (DatasetInfo{"movi-a", "0.1.0", 7, 0, 1, 3}));
+  EXPECT_EQ(info, (DatasetInfo{"movi-a", "0.1.0", 7, 0, 1, 3, 0, 3, 6}));
   // Shards read back in order.
   write_trajectories(dir_ / "shard1.h5", make_data(2), {"movi-a", "0.1.0", 8});
   EXPECT_EQ(read_trajectories({dir_ / "set.h5", dir_ / "shard1.h5"}).size(), 5u);

@@ -190,6 +190,9 @@ void write_trajectories(const std::filesystem::path& path, std::span<const Traje
     hdf5::write_attribute(root, "stacks", static_cast<long long>(info.stacks));
     hdf5::write_attribute(root, "min_stack_levels", static_cast<long long>(info.min_stack_levels));
     hdf5::write_attribute(root, "max_stack_levels", static_cast<long long>(info.max_stack_levels));
+    hdf5::write_attribute(root, "piles", static_cast<long long>(info.piles));
+    hdf5::write_attribute(root, "min_pile_objects", static_cast<long long>(info.min_pile_objects));
+    hdf5::write_attribute(root, "max_pile_objects", static_cast<long long>(info.max_pile_objects));
     hdf5::write_attribute(root, "num_trajectories", static_cast<long long>(trajectories.size()));
     H5::Group group = hdf5::create_group(file, "trajectories");
     for (size_t i = 0; i < trajectories.size(); ++i) {
@@ -226,6 +229,10 @@ long long read_file(const std::filesystem::path& path, DatasetInfo* info, long l
       // Files written before the levels were an option hold stacks of 1–3.
       info->min_stack_levels = static_cast<int>(hdf5::read_integer_or(root, "min_stack_levels", 1));
       info->max_stack_levels = static_cast<int>(hdf5::read_integer_or(root, "max_stack_levels", 3));
+      // Files written before piles existed hold none.
+      info->piles = static_cast<int>(hdf5::read_integer_or(root, "piles", 0));
+      info->min_pile_objects = static_cast<int>(hdf5::read_integer_or(root, "min_pile_objects", 3));
+      info->max_pile_objects = static_cast<int>(hdf5::read_integer_or(root, "max_pile_objects", 6));
     }
     const long long count = hdf5::read_integer(root, "num_trajectories");
     const H5::Group group = file.openGroup("trajectories");

@@ -12,6 +12,7 @@
 namespace fignet::bullet {
 
 inline constexpr int kMaxStackLevels = 10;
+inline constexpr int kMaxPileObjects = 20;
 
 struct MoviOptions {
   std::string preset = "movi-a";  // "movi-a", "movi-b", "movi-c" or "pushing"
@@ -25,6 +26,14 @@ struct MoviOptions {
   // Levels per stack, uniform in this range (at most kMaxStackLevels). 1–3 is what the stacks
   // data of issue 14 used; taller stacks put more of the data's rest on other bodies.
   int min_stack_levels = 1, max_stack_levels = 3;
+  // Settled piles when the scene starts, this many per scene: min_pile_objects–max_pile_objects
+  // of the preset's objects dropped in a narrow column and settled by Bullet before the first
+  // frame, so bodies lean on one another and on the floor at odd angles, which neither MOVi nor
+  // the stacks show. They start still, but round bodies may roll off (Bullet has no rolling
+  // friction here). Placed after the stacks and before the tossed objects, from their own
+  // generator; 0 keeps the scenes without piles, bit for bit.
+  int piles = 0;
+  int min_pile_objects = 3, max_pile_objects = 6;
   // A folder of mesh files: extra objects for movi-b, the only objects of movi-c.
   std::filesystem::path assets;
   // How asset meshes become bodies: repair, node budget, inertia mode (see mesh_import.h).
@@ -48,7 +57,13 @@ struct MoviOptions {
 // high (uniform), each level a cube or an upright cylinder
 // of the preset's scales and materials, turned by a uniform angle about the vertical, shifted by
 // at most a tenth of the smaller of its and its support's half-widths, and resting on its support
-// at the collision margin. Throws ConfigError for a bad option,
+// at the collision margin. options.piles adds settled piles (a variant, not MOVi): each of
+// min_pile_objects–max_pile_objects (uniform) objects drawn as the tossed ones are (shape, scale,
+// material), at random orientations, one above the other with up to 0.3 m of horizontal jitter,
+// dropped into a 5.8 m square bin of still walls and settled by Bullet for 3 s, then 3 s more
+// without the bin (each run from the last one's poses, still), then moved whole to a uniform spot
+// in (−4,−4)–(4,4) clear of the bodies before it (≤ 100 tries, else left out), still. Throws
+// ConfigError for a bad option,
 // FileError or MeshError for a bad asset folder or file.
 SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed);
 

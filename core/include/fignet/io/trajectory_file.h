@@ -22,6 +22,8 @@ struct DatasetInfo {
   std::uint64_t seed = 0;         // the generator's base seed
   int stacks = 0;                 // stacks at rest per scene (generate --stacks); 0: the preset's
   int min_stack_levels = 1, max_stack_levels = 3;  // levels per stack (generate --*-stack-levels)
+  int piles = 0;  // settled piles at rest per scene (generate --piles)
+  int min_pile_objects = 3, max_pile_objects = 6;  // objects per pile (generate --*-pile-objects)
 
   bool operator==(const DatasetInfo&) const = default;
 };
