@@ -102,6 +102,32 @@ bool clear_of(const BoundingSpheres& placed, const Vec3& center, double radius) 
   return true;
 }
 
+double bounding_radius(const BodySpec& body) {
+  return body.mesh->vertices().rowwise().norm().maxCoeff();
+}
+
+// Moves `group` (built around the vertical axis through the origin) whole to a uniform spot in
+// (−4,−4)–(4,4) where no body's bounding sphere meets one of `placed`, and appends its bodies to
+// spec; left out after 100 tries.
+void place_clear(std::vector<BodySpec>& group, std::mt19937_64& rng, SceneSpec& spec,
+                 BoundingSpheres& placed) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const Vec3 spot(-4 + 8 * unit(rng), -4 + 8 * unit(rng), 0.0);
+    bool clear = true;
+    for (const BodySpec& body : group) {
+      clear = clear && clear_of(placed, body.pose.position + spot, bounding_radius(body));
+    }
+    if (!clear) continue;
+    for (BodySpec& body : group) {
+      body.pose.position += spot;
+      placed.emplace_back(body.pose.position, bounding_radius(body));
+      spec.bodies.push_back(std::move(body));
+    }
+    return;
+  }
+}
+
 // options.stacks stacks of cubes and upright cylinders at rest on spec's floor. Their own
 // generator keeps the tossed objects' draws as MOVi's; `placed` receives their bounding spheres
 // so the tossed objects spawn clear of them.
@@ -143,22 +169,7 @@ void add_stacks(const MoviOptions& options, bool movi_a, std::uint64_t seed, Sce
       half_widths.push_back(scale);
       stack.push_back(std::move(body));
     }
-    // A spot where no body's bounding sphere meets an earlier stack's.
-    for (int attempt = 0; attempt < 100; ++attempt) {
-      const Vec3 spot(-4 + 8 * unit(rng), -4 + 8 * unit(rng), 0.0);
-      bool clear = true;
-      for (const BodySpec& body : stack) {
-        const double radius = body.mesh->vertices().rowwise().norm().maxCoeff();
-        clear = clear && clear_of(placed, body.pose.position + spot, radius);
-      }
-      if (!clear) continue;
-      for (BodySpec& body : stack) {
-        body.pose.position += spot;
-        placed.emplace_back(body.pose.position, body.mesh->vertices().rowwise().norm().maxCoeff());
-        spec.bodies.push_back(std::move(body));
-      }
-      break;
-    }
+    place_clear(stack, rng, spec, placed);
   }
 }
 
@@ -166,7 +177,26 @@ void add_stacks(const MoviOptions& options, bool movi_a, std::uint64_t seed, Sce
 // side.
 constexpr double kPileBinHalfWidth = 2.9;
 
-// options.piles piles of the preset's objects, dropped in a column and settled by Bullet, at rest
+// Four still walls around the vertical axis through the origin, an inner half-width of
+// kPileBinHalfWidth, `height` tall and more, so nothing bounces out of the bin.
+std::vector<BodySpec> pile_bin(double height) {
+  std::vector<BodySpec> walls;
+  for (int side = 0; side < 4; ++side) {
+    const bool along_x = side < 2;
+    const double sign = side % 2 == 0 ? 1.0 : -1.0;
+    const double long_half = kPileBinHalfWidth + 0.5, tall_half = 0.5 * height + 1.0;
+    const Vec3 half = along_x ? Vec3(0.25, long_half, tall_half) : Vec3(long_half, 0.25, tall_half);
+    BodySpec wall = make_body(make_box(half), 1.0, 0.5, 0.3);
+    wall.kinematic = true;
+    wall.properties.mass = 0.0;
+    const double offset = sign * (kPileBinHalfWidth + 0.25);
+    wall.pose.position = along_x ? Vec3(offset, 0.0, tall_half) : Vec3(0.0, offset, tall_half);
+    walls.push_back(std::move(wall));
+  }
+  return walls;
+}
+
+// options.piles piles of the preset's objects, dropped in a column and settled by Bullet, still
 // on spec's floor. Their own generator keeps the tossed objects' draws as MOVi's; `placed`
 // receives their bounding spheres so later bodies spawn clear of them.
 void add_piles(const MoviOptions& options, bool movi_a, const std::vector<Source>& sources,
@@ -175,9 +205,6 @@ void add_piles(const MoviOptions& options, bool movi_a, const std::vector<Source
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> normal;
   const int source_count = static_cast<int>(sources.size());
-  auto bounding_radius = [](const BodySpec& body) {
-    return body.mesh->vertices().rowwise().norm().maxCoeff();
-  };
   for (int p = 0; p < options.piles; ++p) {
     const int span = options.max_pile_objects - options.min_pile_objects;
     const int count =
@@ -218,37 +245,9 @@ void add_piles(const MoviOptions& options, bool movi_a, const std::vector<Source
         drop.bodies[i].linear_velocity = drop.bodies[i].angular_velocity = Vec3::Zero();
       }
     };
-    std::vector<BodySpec> bin;
-    for (int side = 0; side < 4; ++side) {
-      const bool along_x = side < 2;
-      const double sign = side % 2 == 0 ? 1.0 : -1.0;
-      // As tall as the column, so nothing bounces out.
-      const Vec3 half = along_x ? Vec3(0.25, kPileBinHalfWidth + 0.5, 0.5 * height + 1.0)
-                                : Vec3(kPileBinHalfWidth + 0.5, 0.25, 0.5 * height + 1.0);
-      BodySpec wall = make_body(make_box(half), 1.0, 0.5, 0.3);
-      wall.kinematic = true;
-      wall.properties.mass = 0.0;
-      wall.pose.position = along_x ? Vec3(sign * (kPileBinHalfWidth + 0.25), 0.0, half.z())
-                                   : Vec3(0.0, sign * (kPileBinHalfWidth + 0.25), half.z());
-      bin.push_back(std::move(wall));
-    }
-    settle(bin);
+    settle(pile_bin(height));
     settle({});
-    // A spot where no body's bounding sphere meets an earlier body's.
-    for (int attempt = 0; attempt < 100; ++attempt) {
-      const Vec3 spot(-4 + 8 * unit(rng), -4 + 8 * unit(rng), 0.0);
-      bool clear = true;
-      for (const BodySpec& body : drop.bodies) {
-        clear = clear && clear_of(placed, body.pose.position + spot, bounding_radius(body));
-      }
-      if (!clear) continue;
-      for (BodySpec& body : drop.bodies) {
-        body.pose.position += spot;
-        placed.emplace_back(body.pose.position, bounding_radius(body));
-        spec.bodies.push_back(std::move(body));
-      }
-      break;
-    }
+    place_clear(drop.bodies, rng, spec, placed);
   }
 }
 

@@ -97,6 +97,13 @@ TEST_F(TrajectoryFile, WriteThenReadRoundTripsExactly) {
   // Shards read back in order.
   write_trajectories(dir_ / "shard1.h5", make_data(2), {"movi-a", "0.1.0", 8});
   EXPECT_EQ(read_trajectories({dir_ / "set.h5", dir_ / "shard1.h5"}).size(), 5u);
+  // A file without piles carries no pile attributes: its bytes are those of before piles existed.
+  {
+    H5::H5File file(std::string(dir_ / "shard1.h5"), H5F_ACC_RDONLY);
+    const H5::Group root = file.openGroup("/");
+    for (const char* name : {"piles", "min_pile_objects", "max_pile_objects"})
+      EXPECT_FALSE(root.attrExists(name)) << name;
+  }
 }
 
 // No object carries HDF5's time stamps: the same scenes written at another time are the same

@@ -190,9 +190,15 @@ void write_trajectories(const std::filesystem::path& path, std::span<const Traje
     hdf5::write_attribute(root, "stacks", static_cast<long long>(info.stacks));
     hdf5::write_attribute(root, "min_stack_levels", static_cast<long long>(info.min_stack_levels));
     hdf5::write_attribute(root, "max_stack_levels", static_cast<long long>(info.max_stack_levels));
-    hdf5::write_attribute(root, "piles", static_cast<long long>(info.piles));
-    hdf5::write_attribute(root, "min_pile_objects", static_cast<long long>(info.min_pile_objects));
-    hdf5::write_attribute(root, "max_pile_objects", static_cast<long long>(info.max_pile_objects));
+    // Only files with piles say so: every other file keeps the bytes it had before piles existed
+    // (the md5 sums that runs/*/README.md give for their data).
+    if (info.piles > 0) {
+      hdf5::write_attribute(root, "piles", static_cast<long long>(info.piles));
+      hdf5::write_attribute(root, "min_pile_objects",
+                            static_cast<long long>(info.min_pile_objects));
+      hdf5::write_attribute(root, "max_pile_objects",
+                            static_cast<long long>(info.max_pile_objects));
+    }
     hdf5::write_attribute(root, "num_trajectories", static_cast<long long>(trajectories.size()));
     H5::Group group = hdf5::create_group(file, "trajectories");
     for (size_t i = 0; i < trajectories.size(); ++i) {
