@@ -102,6 +102,19 @@ bool clear_of(const BoundingSpheres& placed, const Vec3& center, double radius) 
   return true;
 }
 
+// An object's scale and material as the preset draws them (one draw each): MOVi-A 0.7 or 1.4,
+// MOVi-B U(0.7, 1.4), MOVi-C U(0.75, 3.0); metal or rubber, MOVi-C's scanned material.
+double draw_scale(bool movi_a, bool movi_c, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  return movi_a   ? (unit(rng) < 0.5 ? 0.7 : 1.4)
+         : movi_c ? 0.75 + 2.25 * unit(rng)
+                  : 0.7 + 0.7 * unit(rng);
+}
+const Material& draw_material(bool movi_c, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  return movi_c ? kScanned : (unit(rng) < 0.5 ? kMetal : kRubber);
+}
+
 double bounding_radius(const BodySpec& body) {
   return body.mesh->vertices().rowwise().norm().maxCoeff();
 }
@@ -149,8 +162,8 @@ void add_stacks(const MoviOptions& options, bool movi_a, std::uint64_t seed, Sce
     Vec3 below_center = Vec3::Zero();
     for (int level = 0; level < levels; ++level) {
       const Source& shape = shapes[unit(rng) < 0.5 ? 0 : 1];
-      const double scale = movi_a ? (unit(rng) < 0.5 ? 0.7 : 1.4) : 0.7 + 0.7 * unit(rng);
-      const Material& material = unit(rng) < 0.5 ? kMetal : kRubber;
+      const double scale = draw_scale(movi_a, false, rng);
+      const Material& material = draw_material(false, rng);
       BodySpec body = make_object(shape, options.mesh_import, material, scale);
       const double yaw = 2.0 * std::numbers::pi * unit(rng);
       body.pose.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
@@ -211,17 +224,13 @@ void add_piles(const MoviOptions& options, bool movi_a, const std::vector<Source
         options.min_pile_objects + std::min(span, static_cast<int>(unit(rng) * (span + 1)));
     // A column around the vertical axis through the origin, each body clear above the last, in
     // a scene of its own with the same floor and physics.
-    SceneSpec drop;
-    drop.floor = spec.floor;
-    drop.gravity = spec.gravity;
-    drop.physics_step = spec.physics_step;
-    drop.steps_per_frame = spec.steps_per_frame;
-    drop.collision_margin = spec.collision_margin;
+    SceneSpec drop = spec;
+    drop.bodies.clear();
     double height = spec.floor->height;
     for (int i = 0; i < count; ++i) {
       const Source& source = sources[static_cast<int>(unit(rng) * source_count) % source_count];
-      const double scale = movi_a ? (unit(rng) < 0.5 ? 0.7 : 1.4) : 0.7 + 0.7 * unit(rng);
-      const Material& material = unit(rng) < 0.5 ? kMetal : kRubber;
+      const double scale = draw_scale(movi_a, false, rng);
+      const Material& material = draw_material(false, rng);
       BodySpec body = make_object(source, options.mesh_import, material, scale);
       const double radius = bounding_radius(body);
       body.pose.orientation =
@@ -341,13 +350,10 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
   if (options.piles > 0) add_piles(options, movi_a, sources, seed, spec, spheres);
   for (int i = 0; i < std::min(count, options.max_objects); ++i) {
     const Source& source = sources[static_cast<int>(unit(rng) * source_count) % source_count];
-    // Scale: MOVi-A 0.7 or 1.4, MOVi-B U(0.7, 1.4), MOVi-C U(0.75, 3.0).
-    const double scale = movi_a   ? (unit(rng) < 0.5 ? 0.7 : 1.4)
-                         : movi_c ? 0.75 + 2.25 * unit(rng)
-                                  : 0.7 + 0.7 * unit(rng);
-    const Material& material = movi_c ? kScanned : (unit(rng) < 0.5 ? kMetal : kRubber);
+    const double scale = draw_scale(movi_a, movi_c, rng);
+    const Material& material = draw_material(movi_c, rng);
     BodySpec body = make_object(source, options.mesh_import, material, scale);
-    const double radius = body.mesh->vertices().rowwise().norm().maxCoeff();
+    const double radius = bounding_radius(body);
     bool placed = false;
     for (int attempt = 0; attempt < 100 && !placed; ++attempt) {
       body.pose.orientation =

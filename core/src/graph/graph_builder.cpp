@@ -141,23 +141,18 @@ void GraphBuilder::find_interacting(const Scene& scene,
   contacts_.update(posed_, !face_collisions);
   select_pairs(candidates);
   interacting.assign(objects_.size(), 0);
-  if (found) {
-    found->faces.clear();
-    found->nodes.clear();
-  }
-  // The same search build() makes: a collision edge marks both of its objects.
+  // The same search build() makes, into the caller's lists when it keeps them: a collision edge
+  // marks both of its objects.
+  std::vector<FacePair>& faces = found ? found->faces : scene_face_pairs_;
+  std::vector<NodePair>& nodes = found ? found->nodes : node_pairs_;
+  faces.clear();
+  nodes.clear();
   if (face_collisions) {
-    contacts_.find_face_pairs(pairs_, config_.collision_radius, scene_face_pairs_);
-    for (const FacePair& pair : scene_face_pairs_) {
-      interacting[pair.object_a] = interacting[pair.object_b] = 1;
-    }
-    if (found) found->faces = scene_face_pairs_;
+    contacts_.find_face_pairs(pairs_, config_.collision_radius, faces);
+    for (const FacePair& pair : faces) interacting[pair.object_a] = interacting[pair.object_b] = 1;
   } else {
-    contacts_.find_node_pairs(pairs_, config_.collision_radius, node_pairs_);
-    for (const NodePair& pair : node_pairs_) {
-      interacting[pair.object_a] = interacting[pair.object_b] = 1;
-    }
-    if (found) found->nodes = node_pairs_;
+    contacts_.find_node_pairs(pairs_, config_.collision_radius, nodes);
+    for (const NodePair& pair : nodes) interacting[pair.object_a] = interacting[pair.object_b] = 1;
   }
   // An implicit floor has no edges; a node within the radius sees it in its features.
   if (config_.floor != FloorModel::kImplicit || !scene.floor) return;

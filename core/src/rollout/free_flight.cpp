@@ -27,9 +27,9 @@ void FreeFlightSplit::split(GraphBuilder& builder, const Scene& scene,
                             const std::span<const ObjectPair>* candidates, Scene& kept,
                             SceneContacts& kept_contacts) {
   if (candidates) {
-    builder.find_interacting_objects(scene, *candidates, interacting_, &found_);
+    builder.find_interacting_objects(scene, *candidates, interacting_, &kept_contacts);
   } else {
-    builder.find_interacting_objects(scene, interacting_, &found_);
+    builder.find_interacting_objects(scene, interacting_, &kept_contacts);
   }
   // interacting_ may end with the mesh floor, which builds append whatever the scene holds.
   const size_t objects = scene.objects.size();
@@ -46,14 +46,13 @@ void FreeFlightSplit::split(GraphBuilder& builder, const Scene& scene,
   for (size_t k = 0; k < kept_objects_.size(); ++k) {
     kept.objects[k] = scene.objects[kept_objects_[k]];  // reuses the buffers of a like object
   }
-  // Both objects of a collision pair are kept (the pair is their edge), and renumbering keeps the
-  // pairs' order, so the kept scene's graph is the one a search of it would give.
-  kept_contacts.faces = found_.faces;
+  // The search's pairs, renumbered in place: both objects of a collision pair are kept (the pair
+  // is their edge), and renumbering keeps the pairs' order, so the kept scene's graph is the one a
+  // search of it would give.
   for (FacePair& pair : kept_contacts.faces) {
     pair.object_a = kept_index_[pair.object_a];
     pair.object_b = kept_index_[pair.object_b];
   }
-  kept_contacts.nodes = found_.nodes;
   for (NodePair& pair : kept_contacts.nodes) {
     pair.object_a = kept_index_[pair.object_a];
     pair.object_b = kept_index_[pair.object_b];

@@ -52,7 +52,6 @@ class FreeFlightSplit {
 
  private:
   std::vector<char> interacting_;
-  SceneContacts found_;
   std::vector<int> kept_index_, kept_objects_;
   std::vector<ObjectPair> kept_candidates_;
 };
