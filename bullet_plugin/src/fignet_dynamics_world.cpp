@@ -33,6 +33,14 @@ bool is_dynamic(const btCollisionObject* object) {
   return btRigidBody::upcast(object) && !object->isStaticOrKinematicObject();
 }
 
+// Whether two graph configs find the same collision pairs in a scene: then the world's search
+// can stand for the predictor's.
+bool same_contact_search(const GraphConfig& a, const GraphConfig& b) {
+  return a.collision_radius == b.collision_radius && a.collisions == b.collisions &&
+         a.floor == b.floor && a.floor_half_extent == b.floor_half_extent &&
+         a.floor_segments == b.floor_segments;
+}
+
 // A static plane whose world normal is +z: the floor the model was trained with.
 std::optional<Floor> as_floor(const btCollisionObject& object) {
   if (object.getCollisionShape()->getShapeType() != STATIC_PLANE_PROXYTYPE) return std::nullopt;
@@ -170,6 +178,9 @@ struct FIGNetDynamicsWorld::Impl {
   std::vector<char> in_network;              // per moving body: predicted by the network
   std::vector<int> networked;     // moving bodies that are scene.objects[0 … n), in order
   std::vector<char> interacting;  // per scene object: has a collision edge
+  SceneContacts contacts;         // and the collision pairs of that search
+  bool scene_searched = false;    // the search was of the scene as it stands: the network reuses it
+  bool share_search = true;       // the predictor searches as contact_query does
   std::vector<const btCollisionObject*> scene_owners;  // per scene object: whose it is
   // The floor plane, and the groups of its partners that each get a floor mesh of their own.
   struct FloorGroup {
@@ -516,15 +527,22 @@ struct FIGNetDynamicsWorld::Impl {
     // Bodies that stand at rest leave the network first (the cheaper test); to the bodies near
     // them they are obstacles that do not move.
     if (hold_resting_bodies(world)) build_scene();
+    scene_searched = false;
     if (options.free_flight && !networked.empty()) {
-      contact_query->find_interacting_objects(scene, candidates, interacting);
+      contact_query->find_interacting_objects(scene, candidates, interacting, &contacts);
       bool all_interact = true;
       for (size_t k = 0; k < networked.size(); ++k) {
         if (interacting[k]) continue;
         in_network[networked[k]] = 0;
         all_interact = false;
       }
-      if (!all_interact) build_scene();
+      // A scene rebuilt without the bodies in free flight numbers its objects anew and is
+      // searched again; one that stands is not.
+      if (all_interact) {
+        scene_searched = share_search;
+      } else {
+        build_scene();
+      }
     }
   }
 
@@ -542,7 +560,12 @@ struct FIGNetDynamicsWorld::Impl {
   void advance() {
     next.resize(moving.size());
     if (!networked.empty()) {
-      predictor->predict_with_candidates(scene, candidates, workspace.accelerations);
+      if (scene_searched) {
+        predictor->predict_with_search(scene, candidates, interacting, contacts,
+                                       workspace.accelerations);
+      } else {
+        predictor->predict_with_candidates(scene, candidates, workspace.accelerations);
+      }
       integrate_next_poses(scene, network_next, workspace);
       for (size_t k = 0; k < networked.size(); ++k) next[networked[k]] = network_next[k];
     }
@@ -987,6 +1010,9 @@ FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
   impl_->time_step = time_step;
   impl_->gravity = gravity;
   impl_->contact_query.emplace(graph);
+  if (const auto* model = dynamic_cast<const ModelPredictor*>(impl_->predictor.get())) {
+    impl_->share_search = same_contact_search(model->builder().config(), graph);
+  }
   impl_->floor_patch = make_floor_mesh(graph.floor_half_extent, graph.floor_segments);
   for (const auto& [name, value] :
        {std::pair("penetration_tolerance", options.penetration_tolerance),

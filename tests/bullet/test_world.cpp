@@ -658,6 +658,38 @@ TEST(FIGNetWorld, ABodyFarFromTheOriginStillMeetsTheFloor) {
   }
 }
 
+// The world searches contacts to choose the bodies it passes; when it passes all it searched, the
+// network's graph is built from that search (one search a step), and when it leaves some to free
+// flight, the scene it passes is numbered anew and searched again.
+TEST(FIGNetWorld, TheNetworkReusesTheWorldsContactSearchWhenTheSceneStands) {
+  auto predictor = testing::recording_predictor();
+  auto* recorder = predictor.get();
+  testing::WorldFixture fixture(std::move(predictor));
+  fixture.add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0, Pose{});
+  Pose pose;
+  pose.position = Vec3(0, 0, 0.25);
+  fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.2f, 0.2f)), 1.0, pose);
+  fixture.step();
+  EXPECT_EQ(recorder->calls, 1);
+  EXPECT_EQ(recorder->searched_calls, 1);
+  // The box and the floor mesh after it, with the face pairs between them.
+  EXPECT_EQ(recorder->last_interacting, (std::vector<char>{1, 1}));
+  EXPECT_FALSE(recorder->last_contacts.faces.empty());
+  for (const FacePair& pair : recorder->last_contacts.faces) {
+    EXPECT_EQ(pair.object_a, 0);
+    EXPECT_EQ(pair.object_b, 1);
+  }
+  // A sphere in the air off the box's top corner: their boxes overlap (a broadphase pair), their
+  // surfaces are 0.13 m apart, out of the collision radius.
+  pose.position = Vec3(0.39, 0.39, 0.64);
+  fixture.add(std::make_unique<btSphereShape>(0.2f), 1.0, pose);
+  fixture.step();
+  EXPECT_EQ(fixture.world.last_step_stats().free_flight_bodies, 1);
+  EXPECT_EQ(recorder->calls, 2);
+  EXPECT_EQ(recorder->searched_calls, 1);
+  EXPECT_EQ(recorder->last_scene.objects.size(), 1u);
+}
+
 // Bodies on the floor farther apart than its mesh reaches (±40 m) each have floor under them: the
 // first group the scene's floor, the others a floor patch of the same mesh and properties.
 TEST(FIGNetWorld, BodiesFarApartEachHaveFloorUnderThem) {

@@ -30,9 +30,21 @@ class RecordingPredictor : public GravityPredictor {
     ++calls;
     predict(scene, accelerations);
   }
+  void predict_with_search(const Scene& scene, std::span<const ObjectPair> candidates,
+                           std::span<const char> interacting, const SceneContacts& contacts,
+                           Points& accelerations) override {
+    last_interacting.assign(interacting.begin(), interacting.end());
+    last_contacts = contacts;
+    ++searched_calls;
+    predict_with_candidates(scene, candidates, accelerations);
+  }
   Scene last_scene;
   std::vector<ObjectPair> last_candidates;
-  int calls = 0;
+  int calls = 0;  // every prediction
+  // Predictions handed the world's contact search, and the last search handed.
+  int searched_calls = 0;
+  std::vector<char> last_interacting;
+  SceneContacts last_contacts;
 };
 
 struct WorldFixture {

@@ -2,6 +2,7 @@
 // predictor that leaves bodies without a collision edge to it, and training without them.
 #include <gtest/gtest.h>
 
+#include "fignet/error.h"
 #include "fignet/rollout/free_flight.h"
 #include "fignet/rollout/predictor.h"
 #include "fignet/rollout/rigid_fit.h"
@@ -113,6 +114,77 @@ TEST(FreeFlight, PredictorLeavesBodiesWithoutCollisionEdgesToFreeFlight) {
   EXPECT_EQ(contact_only.last_graph().num_mesh_nodes(),
             contact_only.last_graph().object_first_node.back());
   EXPECT_EQ(contact_only.last_graph().num_objects(), 1);  // the floor
+}
+
+// A caller that has searched the scene already (the Bullet world, to choose the bodies it passes)
+// hands the search on: the same accelerations to the bit as the predictor's own search gives, for
+// a model that omits free flight, one asked to, one that sees every body, and with turns.
+TEST(FreeFlight, PredictorReusesTheCallersSearch) {
+  const Trajectory both = flying_and_resting_cubes(8);
+  Scene scene;
+  scene_at_frame(both, 4, 2, scene);
+  // A kinematic body near the flying cube but out of its reach: a candidate without an edge.
+  scene.objects.push_back(scene.objects[1]);
+  SceneObject& post = scene.objects.back();
+  const Eigen::RowVector3d lift(0.5, 0, 2.0);
+  post.kinematic = true;
+  post.properties.mass = 0.0;
+  post.positions.rowwise() += lift;
+  post.centers.rowwise() += lift;
+  post.next_positions = post.positions_at(post.num_steps() - 1);
+  post.next_center = post.centers.bottomRows(1).transpose();
+  const auto whole = testing::random_model(scene, small_model(false));
+  const auto omitting =
+      std::make_shared<const Model>(small_model(true), whole->parameters(), whole->normalizers());
+  // The floor is object 3.
+  const std::vector<ObjectPair> pairs = {{0, 1}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
+  GraphBuilder search(whole->config().graph);
+  std::vector<char> interacting;
+  SceneContacts contacts;
+  search.find_interacting_objects(scene, pairs, interacting, &contacts);
+  ASSERT_EQ(interacting, (std::vector<char>{0, 1, 0, 1}));
+  struct Case {
+    const char* name;
+    std::shared_ptr<const Model> model;
+    PredictionOptions options;
+  };
+  const Case cases[] = {
+      {"omitting", omitting, {.threads = 1}},
+      {"asked to", whole, {.threads = 1, .free_flight = true}},
+      {"every body", whole, {.threads = 1}},
+      {"two turns", omitting, {.threads = 1, .turns = 2}},
+      {"every body, two turns", whole, {.threads = 1, .turns = 2}},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    ModelPredictor own(c.model, c.options), given(c.model, c.options);
+    Points searched_here, searched_before;
+    own.predict_with_candidates(scene, pairs, searched_here);
+    given.predict_with_search(scene, pairs, interacting, contacts, searched_before);
+    EXPECT_EQ(searched_before, searched_here);
+    EXPECT_EQ(given.last_graph().face_edges.size(), own.last_graph().face_edges.size());
+    EXPECT_EQ(given.last_graph().num_objects(), own.last_graph().num_objects());
+  }
+  // A search that is not of this scene is refused, naming what does not match.
+  ModelPredictor predictor(omitting, {.threads = 1});
+  auto error_of = [&](std::span<const char> flags) -> std::string {
+    Points accelerations;
+    try {
+      predictor.predict_with_search(scene, pairs, flags, contacts, accelerations);
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "no ConfigError thrown";
+    return {};
+  };
+  const std::vector<char> too_few(2, 1);
+  EXPECT_NE(error_of(too_few).find("2 interaction flags for a scene of 3 objects"),
+            std::string::npos);
+  std::vector<char> resting_unflagged = interacting;
+  resting_unflagged[1] = 0;  // its face pairs with the floor now join an object without an edge
+  ASSERT_FALSE(contacts.faces.empty());
+  EXPECT_NE(error_of(resting_unflagged).find("face pair 0 joins objects 1 and 3"),
+            std::string::npos);
 }
 
 // Training without free flight is training on the bodies in contact alone: the same graphs,

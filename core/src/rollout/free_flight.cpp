@@ -1,5 +1,8 @@
 #include "fignet/rollout/free_flight.h"
 
+#include <fmt/format.h>
+
+#include "fignet/error.h"
 #include "fignet/rollout/rigid_fit.h"
 
 namespace fignet {
@@ -31,6 +34,44 @@ void FreeFlightSplit::split(GraphBuilder& builder, const Scene& scene,
   } else {
     builder.find_interacting_objects(scene, interacting_, &kept_contacts);
   }
+  keep(scene, candidates, kept, kept_contacts);
+}
+
+void FreeFlightSplit::split_searched(const Scene& scene, std::span<const char> interacting,
+                                     const SceneContacts& contacts,
+                                     const std::span<const ObjectPair>* candidates, Scene& kept,
+                                     SceneContacts& kept_contacts) {
+  // One flag per object, and one more for a mesh floor (the builder appends it to any scene).
+  const size_t objects = scene.objects.size();
+  if (interacting.size() != objects && interacting.size() != objects + 1) {
+    throw ConfigError(fmt::format(
+        "FreeFlightSplit: {} interaction flags for a scene of {} objects; expected {} or {} (with "
+        "a mesh floor)",
+        interacting.size(), objects, objects, objects + 1));
+  }
+  // Both objects of a collision pair have an edge; anything else is not this scene's search.
+  auto check = [&](const char* kind, size_t p, int a, int b) {
+    const int flags = static_cast<int>(interacting.size());
+    if (a < 0 || b < 0 || a >= flags || b >= flags || !interacting[a] || !interacting[b]) {
+      throw ConfigError(fmt::format(
+          "FreeFlightSplit: {} pair {} joins objects {} and {}, which are not both among the {} "
+          "objects flagged as interacting",
+          kind, p, a, b, flags));
+    }
+  };
+  for (size_t p = 0; p < contacts.faces.size(); ++p) {
+    check("face", p, contacts.faces[p].object_a, contacts.faces[p].object_b);
+  }
+  for (size_t p = 0; p < contacts.nodes.size(); ++p) {
+    check("node", p, contacts.nodes[p].object_a, contacts.nodes[p].object_b);
+  }
+  interacting_.assign(interacting.begin(), interacting.end());
+  kept_contacts = contacts;  // copy-assigned: a steady-state step reuses the last one's buffers
+  keep(scene, candidates, kept, kept_contacts);
+}
+
+void FreeFlightSplit::keep(const Scene& scene, const std::span<const ObjectPair>* candidates,
+                           Scene& kept, SceneContacts& kept_contacts) {
   // interacting_ may end with the mesh floor, which builds append whatever the scene holds.
   const size_t objects = scene.objects.size();
   kept_index_.assign(objects + 1, -1);

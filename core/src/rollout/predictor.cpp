@@ -82,31 +82,46 @@ const Scene& ModelPredictor::with_fitted_masses(const Scene& scene) {
 }
 
 void ModelPredictor::predict(const Scene& scene, Points& accelerations) {
-  predict_objects(with_fitted_masses(scene), nullptr, accelerations);
+  predict_objects(with_fitted_masses(scene), nullptr, nullptr, accelerations);
 }
 
 void ModelPredictor::predict_with_candidates(const Scene& scene,
                                              std::span<const ObjectPair> candidates,
                                              Points& accelerations) {
-  predict_objects(with_fitted_masses(scene), &candidates, accelerations);
+  predict_objects(with_fitted_masses(scene), &candidates, nullptr, accelerations);
+}
+
+void ModelPredictor::predict_with_search(const Scene& scene, std::span<const ObjectPair> candidates,
+                                         std::span<const char> interacting,
+                                         const SceneContacts& contacts, Points& accelerations) {
+  // Fitted masses move no face: the search stands for the fitted copy too.
+  const Search search{interacting, contacts};
+  predict_objects(with_fitted_masses(scene), &candidates, &search, accelerations);
 }
 
 void ModelPredictor::predict_objects(const Scene& scene,
                                      const std::span<const ObjectPair>* candidates,
-                                     Points& accelerations) {
+                                     const Search* search, Points& accelerations) {
   // A model trained on bodies in contact only sees those, and so does one asked to; the others
   // fall outside it.
   const bool omit = options_.free_flight || model_->config().graph.omit_free_flight;
-  if (omit) free_flight_.split(builder_, scene, candidates, kept_, kept_contacts_);
+  if (omit && search) {
+    free_flight_.split_searched(scene, search->interacting, search->contacts, candidates, kept_,
+                                kept_contacts_);
+  } else if (omit) {
+    free_flight_.split(builder_, scene, candidates, kept_, kept_contacts_);
+  }
   const std::span<const ObjectPair> pairs =
       !candidates ? std::span<const ObjectPair>()
                   : (omit ? free_flight_.kept_candidates() : *candidates);
   // A turn about the vertical moves no object into or out of a pair: the candidates stand. The
-  // kept scene itself is built from the split's search; a turned copy meets the floor's faces
-  // elsewhere and is searched.
+  // kept scene itself is built from the split's search, and the whole scene from the caller's; a
+  // turned copy meets the floor's faces elsewhere and is searched.
   auto build = [&](const Scene& s) {
     if (&s == &kept_) {
       builder_.build_with_contacts(std::span(&kept_, 1), std::span(&kept_contacts_, 1), graph_);
+    } else if (search && &s == &scene) {
+      builder_.build_with_contacts(std::span(&scene, 1), std::span(&search->contacts, 1), graph_);
     } else if (candidates) {
       builder_.build_with_candidates(s, pairs, graph_);
     } else {

@@ -36,6 +36,12 @@ class FreeFlightSplit {
   void split(GraphBuilder& builder, const Scene& scene,
              const std::span<const ObjectPair>* candidates, Scene& kept,
              SceneContacts& kept_contacts);
+  // As split(), from the search of `scene` the caller made already (find_interacting_objects's
+  // flags and collision pairs, with the same graph config and candidates), so that it is not
+  // made twice. Throws ConfigError when the flags do not match the scene's objects.
+  void split_searched(const Scene& scene, std::span<const char> interacting,
+                      const SceneContacts& contacts, const std::span<const ObjectPair>* candidates,
+                      Scene& kept, SceneContacts& kept_contacts);
   // For each object of the kept scene, its index in the scene split last.
   std::span<const int> kept_objects() const { return kept_objects_; }
   std::span<const ObjectPair> kept_candidates() const { return kept_candidates_; }
@@ -51,6 +57,10 @@ class FreeFlightSplit {
                             const Vec3& gravity_step, Points& accelerations) const;
 
  private:
+  // The kept scene, contacts and candidates from interacting_ and the search's pairs.
+  void keep(const Scene& scene, const std::span<const ObjectPair>* candidates, Scene& kept,
+            SceneContacts& kept_contacts);
+
   std::vector<char> interacting_;
   std::vector<int> kept_index_, kept_objects_;
   std::vector<ObjectPair> kept_candidates_;

@@ -30,6 +30,17 @@ class AccelerationPredictor {
     (void)candidates;
     predict(scene, accelerations);
   }
+  // As predict_with_candidates(), with the contact search of `scene` among those candidates that
+  // the caller has made already (GraphBuilder::find_interacting_objects with the predictor's
+  // graph config: its per-object flags and collision pairs), so that it is not made again.
+  // Predictors without a contact graph ignore it.
+  virtual void predict_with_search(const Scene& scene, std::span<const ObjectPair> candidates,
+                                   std::span<const char> interacting, const SceneContacts& contacts,
+                                   Points& accelerations) {
+    (void)interacting;
+    (void)contacts;
+    predict_with_candidates(scene, candidates, accelerations);
+  }
   // Face–face edges of the last prediction's graph (0 for predictors without a graph).
   virtual int last_face_edges() const { return 0; }
 };
@@ -104,6 +115,9 @@ class ModelPredictor : public AccelerationPredictor {
   void predict(const Scene& scene, Points& accelerations) override;
   void predict_with_candidates(const Scene& scene, std::span<const ObjectPair> candidates,
                                Points& accelerations) override;
+  void predict_with_search(const Scene& scene, std::span<const ObjectPair> candidates,
+                           std::span<const char> interacting, const SceneContacts& contacts,
+                           Points& accelerations) override;
   int last_face_edges() const override { return graph_.face_edges.size(); }
   // The graph of the last prediction (for edge counts and debug drawing).
   const Graph& last_graph() const { return graph_; }
@@ -117,10 +131,16 @@ class ModelPredictor : public AccelerationPredictor {
   void predict_averaged(const Scene& scene, Build&& build, Points& accelerations);
   // The scene the network sees: `scene` itself, or its copy with fitted masses (fit_masses).
   const Scene& with_fitted_masses(const Scene& scene);
+  // A contact search the caller made (predict_with_search).
+  struct Search {
+    std::span<const char> interacting;
+    const SceneContacts& contacts;
+  };
   // predict_averaged on the whole scene, or on its objects with a collision edge only
-  // (omit_free_flight or PredictionOptions::free_flight), the others in free flight.
+  // (omit_free_flight or PredictionOptions::free_flight), the others in free flight. The scene's
+  // own graph comes from `search` when given (it was made among `candidates`).
   void predict_objects(const Scene& scene, const std::span<const ObjectPair>* candidates,
-                       Points& accelerations);
+                       const Search* search, Points& accelerations);
 
   std::shared_ptr<const Model> model_;
   PredictionOptions options_;
