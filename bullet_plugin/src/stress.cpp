@@ -182,6 +182,33 @@ std::vector<CaseRecipe> case_recipes(double scale_frames) {
     }
     cases.push_back(make_case(fmt::format("stack of {} MOVi cubes", n), "stacks", stack, true));
   }
+  // A rubber MOVi sphere (0.7 scale, 1.4 m) on a rubber MOVi cube, resting on a facet of its
+  // equator (where Bullet holds it; on its flat pole cap, a disc as wide as the cube's faces are
+  // squares, models hold it as they hold a cube). The stacks data stacks only cubes and upright
+  // cylinders, and round bodies roll off the data's piles: no sphere rests on another body there.
+  {
+    SceneSpec stack = empty_scene(frames(480));
+    stack.floor->properties = Floor{}.properties;
+    const double half = 0.7, gap = stack.collision_margin;
+    stack.bodies.push_back(make_body(make_box(Vec3::Constant(half)), 1.1, 0.8, 0.7));
+    stack.bodies.back().pose.position = Vec3(0, 0, half + gap);
+    const TriangleMesh unit = make_movi_shape("sphere");
+    BodySpec sphere =
+        make_body(TriangleMesh("sphere", unit.vertices() * half, unit.faces()), 1.1, 0.8, 0.7);
+    // The facets' normals as the shape stands (its poles on the vertical), not in its principal
+    // frame, whose axes a nearly round body leaves to rounding.
+    const Points normals =
+        sphere.mesh->face_normals() * sphere.pose.orientation.toRotationMatrix().transpose();
+    Eigen::Index equator = 0;
+    normals.col(2).cwiseAbs().minCoeff(&equator);
+    sphere.pose.orientation =
+        Eigen::Quaterniond::FromTwoVectors(normals.row(equator).transpose(), -Vec3::UnitZ()) *
+        sphere.pose.orientation;
+    sphere.pose.position.z() +=
+        2 * (half + gap) - posed_vertices(*sphere.mesh, sphere.pose).col(2).minCoeff();
+    stack.bodies.push_back(std::move(sphere));
+    cases.push_back(make_case("MOVi sphere on a MOVi cube", "stacks", stack, true));
+  }
   // Sizes far outside training (0.7–1.4 m objects), and a 100:1 density ratio in contact.
   for (double half : {0.025, 2.5}) {
     SceneSpec drop = empty_scene(frames(240));
