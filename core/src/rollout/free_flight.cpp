@@ -54,8 +54,8 @@ void FreeFlightSplit::split_searched(const Scene& scene, std::span<const char> i
     const int flags = static_cast<int>(interacting.size());
     if (a < 0 || b < 0 || a >= flags || b >= flags || !interacting[a] || !interacting[b]) {
       throw ConfigError(fmt::format(
-          "FreeFlightSplit: {} pair {} joins objects {} and {}, which are not both among the {} "
-          "objects flagged as interacting",
+          "FreeFlightSplit: {} pair {} joins objects {} and {}, but the search's {} flags do not "
+          "mark both as interacting",
           kind, p, a, b, flags));
     }
   };
