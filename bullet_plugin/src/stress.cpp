@@ -112,6 +112,27 @@ CaseRecipe make_case(std::string name, std::string group, SceneSpec scene, bool 
       compare);
 }
 
+// Half the side of a MOVi-A cube at scale 0.7 (1.4 m).
+constexpr double kMoviCubeHalf = 0.7;
+
+// A body of `mesh` in MOVi's rubber (density 1.1, friction 0.8, restitution 0.7).
+BodySpec movi_rubber(const TriangleMesh& mesh) {
+  return make_body(mesh, 1.1, 0.8, 0.7);
+}
+
+// `n` rubber MOVi cubes (1.4 m, 3 kg) stacked on Kubric's floor, each resting on the collision
+// margin, for `frames` frames.
+SceneSpec movi_cube_stack(int n, int frames) {
+  SceneSpec stack = empty_scene(frames);
+  stack.floor->properties = Floor{}.properties;
+  const double half = kMoviCubeHalf, gap = stack.collision_margin;
+  for (int k = 0; k < n; ++k) {
+    stack.bodies.push_back(movi_rubber(make_box(Vec3::Constant(half))));
+    stack.bodies.back().pose.position = Vec3(0, 0, half + gap + k * (2 * half + gap));
+  }
+  return stack;
+}
+
 std::vector<CaseRecipe> case_recipes(double scale_frames) {
   const auto frames = [&](int n) { return std::max(8, static_cast<int>(n * scale_frames)); };
   std::vector<CaseRecipe> cases;
@@ -173,28 +194,18 @@ std::vector<CaseRecipe> case_recipes(double scale_frames) {
   // stacks; these tell a model's own stacking from the suite's floor and masses, which differ
   // from the data's.
   for (int n = 2; n <= 3; ++n) {
-    SceneSpec stack = empty_scene(frames(480));
-    stack.floor->properties = Floor{}.properties;
-    const double half = 0.7, gap = stack.collision_margin;
-    for (int k = 0; k < n; ++k) {
-      stack.bodies.push_back(make_body(make_box(Vec3::Constant(half)), 1.1, 0.8, 0.7));
-      stack.bodies.back().pose.position = Vec3(0, 0, half + gap + k * (2 * half + gap));
-    }
-    cases.push_back(make_case(fmt::format("stack of {} MOVi cubes", n), "stacks", stack, true));
+    cases.push_back(make_case(fmt::format("stack of {} MOVi cubes", n), "stacks",
+                              movi_cube_stack(n, frames(480)), true));
   }
   // A rubber MOVi sphere (0.7 scale, 1.4 m) on a rubber MOVi cube, resting on a facet of its
   // equator (where Bullet holds it; on its flat pole cap, a disc as wide as the cube's faces are
   // squares, models hold it as they hold a cube). The stacks data stacks only cubes and upright
   // cylinders, and round bodies roll off the data's piles: no sphere rests on another body there.
   {
-    SceneSpec stack = empty_scene(frames(480));
-    stack.floor->properties = Floor{}.properties;
-    const double half = 0.7, gap = stack.collision_margin;
-    stack.bodies.push_back(make_body(make_box(Vec3::Constant(half)), 1.1, 0.8, 0.7));
-    stack.bodies.back().pose.position = Vec3(0, 0, half + gap);
+    SceneSpec stack = movi_cube_stack(1, frames(480));
+    const double half = kMoviCubeHalf, gap = stack.collision_margin;
     const TriangleMesh unit = make_movi_shape("sphere");
-    BodySpec sphere =
-        make_body(TriangleMesh("sphere", unit.vertices() * half, unit.faces()), 1.1, 0.8, 0.7);
+    BodySpec sphere = movi_rubber(TriangleMesh("sphere", unit.vertices() * half, unit.faces()));
     // The facets' normals as the shape stands (its poles on the vertical), not in its principal
     // frame, whose axes a nearly round body leaves to rounding.
     const Points normals =
