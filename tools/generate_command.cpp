@@ -109,6 +109,12 @@ void add_generate_command(CLI::App& app) {
       ->needs(stacks)
       ->check(CLI::Range(1, bullet::kMaxStackLevels))
       ->capture_default_str();
+  cmd->add_option("--sphere-topped-stacks", args->options.scene.sphere_topped_stacks,
+                  "Share of the stacks (0-1) topped with a MOVi sphere resting still on one of its "
+                  "facets (with --stacks); 0: none")
+      ->needs(stacks)
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   CLI::Option* piles =
       cmd->add_option("--piles", args->options.scene.piles,
                       "Piles of the preset's objects dropped in a column and settled by Bullet "

@@ -67,7 +67,8 @@ DatasetInfo dataset_info(const GenerateOptions& options, std::string generator_v
           .max_stack_levels = options.scene.max_stack_levels,
           .piles = options.scene.piles,
           .min_pile_objects = options.scene.min_pile_objects,
-          .max_pile_objects = options.scene.max_pile_objects};
+          .max_pile_objects = options.scene.max_pile_objects,
+          .sphere_topped_stacks = options.scene.sphere_topped_stacks};
 }
 
 }  // namespace fignet::bullet

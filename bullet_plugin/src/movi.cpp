@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -13,6 +14,7 @@
 #include "fignet/bullet/mesh_file.h"
 #include "fignet/error.h"
 #include "fignet/geometry/shapes.h"
+#include "fignet/graph/scene.h"
 
 namespace fignet::bullet {
 
@@ -141,12 +143,52 @@ void place_clear(std::vector<BodySpec>& group, std::mt19937_64& rng, SceneSpec& 
   }
 }
 
-// options.stacks stacks of cubes and upright cylinders at rest on spec's floor. Their own
-// generator keeps the tossed objects' draws as MOVi's; `placed` receives their bounding spheres
-// so the tossed objects spawn clear of them.
+// A horizontal shift off a support's axis, uniform over the disc of a tenth of the narrower
+// half-width: the centre of mass stays well inside the support, so what rests on it stands.
+Vec3 off_axis_shift(double half_width, double support_half_width, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double reach = 0.1 * std::min(half_width, support_half_width) * std::sqrt(unit(rng));
+  const double angle = 2.0 * std::numbers::pi * unit(rng);
+  return Vec3(reach * std::cos(angle), reach * std::sin(angle), 0.0);
+}
+
+// A MOVi sphere of the preset's scales and materials resting still on `support`'s flat top at
+// the collision margin, on a facet drawn uniformly: turned so that facet faces straight down (each
+// facet of a sphere mesh holds the centre of mass above it, so Bullet holds it there), then by a
+// uniform angle about the vertical, and shifted off the support's axis as a stack's levels are.
+BodySpec sphere_on_top(const BodySpec& support, double support_half_width,
+                       const MoviOptions& options, bool movi_a, double margin,
+                       std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double scale = draw_scale(movi_a, false, rng);
+  const Material& material = draw_material(false, rng);
+  BodySpec sphere = make_object({"sphere"}, options.mesh_import, material, scale);
+  const Eigen::Index faces = sphere.mesh->faces().rows();
+  const Eigen::Index facet =
+      std::min<Eigen::Index>(faces - 1, static_cast<Eigen::Index>(unit(rng) * faces));
+  const Vec3 facet_normal =
+      sphere.pose.orientation * sphere.mesh->face_normals().row(facet).transpose();
+  const double yaw = 2.0 * std::numbers::pi * unit(rng);
+  sphere.pose.orientation = Eigen::AngleAxisd(yaw, Vec3::UnitZ()) *
+                            Eigen::Quaterniond::FromTwoVectors(facet_normal, -Vec3::UnitZ()) *
+                            sphere.pose.orientation;
+  sphere.pose.position = support.pose.position + off_axis_shift(scale, support_half_width, rng);
+  // Lowest vertex at the margin over the support's top.
+  sphere.pose.position.z() = 0.0;
+  const double top = posed_vertices(*support.mesh, support.pose).col(2).maxCoeff();
+  sphere.pose.position.z() =
+      top + margin - posed_vertices(*sphere.mesh, sphere.pose).col(2).minCoeff();
+  return sphere;
+}
+
+// options.stacks stacks of cubes and upright cylinders at rest on spec's floor, a share of them
+// topped with a sphere. Generators of their own keep the tossed objects' draws as MOVi's, and
+// stacks without spheres as they were before spheres existed; `placed` receives their bounding
+// spheres so the tossed objects spawn clear of them.
 void add_stacks(const MoviOptions& options, bool movi_a, std::uint64_t seed, SceneSpec& spec,
                 BoundingSpheres& placed) {
   std::mt19937_64 rng(seed ^ 0x5374'6163'6b73'0001ULL);
+  std::mt19937_64 sphere_rng(seed ^ 0x5370'6865'7265'0001ULL);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   const Source shapes[] = {{"cube"}, {"cylinder"}};  // both flat on top and bottom when upright
   const double margin = spec.collision_margin;
@@ -167,20 +209,17 @@ void add_stacks(const MoviOptions& options, bool movi_a, std::uint64_t seed, Sce
       BodySpec body = make_object(shape, options.mesh_import, material, scale);
       const double yaw = 2.0 * std::numbers::pi * unit(rng);
       body.pose.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
-      // Shifted off its support's axis by at most a tenth of the narrower half-width: the centre
-      // of mass stays well inside the support, so the stack stands in Bullet.
-      Vec3 shift = Vec3::Zero();
-      if (level > 0) {
-        const double reach = 0.1 * std::min(scale, half_widths.back()) * std::sqrt(unit(rng));
-        const double angle = 2.0 * std::numbers::pi * unit(rng);
-        shift = Vec3(reach * std::cos(angle), reach * std::sin(angle), 0.0);
-      }
+      const Vec3 shift = level > 0 ? off_axis_shift(scale, half_widths.back(), rng) : Vec3::Zero();
       body.pose.position = below_center + shift;
       body.pose.position.z() = top + margin + scale;
       top = body.pose.position.z() + scale;
       below_center = body.pose.position;
       half_widths.push_back(scale);
       stack.push_back(std::move(body));
+    }
+    if (unit(sphere_rng) < options.sphere_topped_stacks) {
+      stack.push_back(
+          sphere_on_top(stack.back(), half_widths.back(), options, movi_a, margin, sphere_rng));
     }
     place_clear(stack, rng, spec, placed);
   }
@@ -308,6 +347,15 @@ SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed) {
                options.max_stack_levels, kMaxStackLevels);
   check_counts("piles", options.piles, "pile objects", options.min_pile_objects,
                options.max_pile_objects, kMaxPileObjects);
+  if (!(options.sphere_topped_stacks >= 0.0 && options.sphere_topped_stacks <= 1.0)) {
+    throw ConfigError(fmt::format("sphere_topped_stacks = {} (a share: needs 0 to 1)",
+                                  options.sphere_topped_stacks));
+  }
+  if (options.sphere_topped_stacks > 0.0 && options.stacks == 0) {
+    throw ConfigError(fmt::format(
+        "sphere_topped_stacks = {} tops stacks with spheres, but stacks = 0: ask for stacks too",
+        options.sphere_topped_stacks));
+  }
   if (options.piles > 0 && movi_c) {
     throw ConfigError("piles need preset movi-a or movi-b, not movi-c");
   }

@@ -268,12 +268,14 @@ shape (frames, objects, 3) and quaternions (frames, objects, 4) as (w, x, y, z).
       [](const std::string& preset, int count, std::uint64_t seed,
          std::optional<std::filesystem::path> path, int frames, int threads,
          std::optional<std::filesystem::path> assets, int stacks, int min_stack_levels,
-         int max_stack_levels, int piles, int min_pile_objects, int max_pile_objects) {
+         int max_stack_levels, int piles, int min_pile_objects, int max_pile_objects,
+         double sphere_topped_stacks) {
         bullet::GenerateOptions options;
         options.scene.preset = preset;
         options.scene.stacks = stacks;
         options.scene.min_stack_levels = min_stack_levels;
         options.scene.max_stack_levels = max_stack_levels;
+        options.scene.sphere_topped_stacks = sphere_topped_stacks;
         options.scene.piles = piles;
         options.scene.min_pile_objects = min_pile_objects;
         options.scene.max_pile_objects = max_pile_objects;
@@ -296,12 +298,13 @@ shape (frames, objects, 3) and quaternions (frames, objects, 4) as (w, x, y, z).
       py::arg("path") = py::none(), py::arg("frames") = 0, py::arg("threads") = 0,
       py::arg("assets") = py::none(), py::arg("stacks") = 0, py::arg("min_stack_levels") = 1,
       py::arg("max_stack_levels") = 3, py::arg("piles") = 0, py::arg("min_pile_objects") = 3,
-      py::arg("max_pile_objects") = 6,
+      py::arg("max_pile_objects") = 6, py::arg("sphere_topped_stacks") = 0.0,
       R"(Simulates `count` scenes of a preset ("movi-a", "movi-b", "movi-c", "pushing") in native
 Bullet, as `fignet generate` does: the same seed gives the same trajectories. Writes them to
 `path` when given; returns them. frames 0: the preset's own; threads 0: every core; stacks:
 stacks at rest added to each movi-a or movi-b scene, as `fignet generate --stacks`, each
-min_stack_levels to max_stack_levels high; piles: piles of min_pile_objects to
+min_stack_levels to max_stack_levels high, a share sphere_topped_stacks of them topped with a
+sphere (`--sphere-topped-stacks`); piles: piles of min_pile_objects to
 max_pile_objects objects settled by Bullet, as `fignet generate --piles`.)");
 }
 

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 
 #include "fignet/bullet/dataset_generator.h"
@@ -282,6 +283,64 @@ TEST(Generator, StacksOfFiveStandInBullet) {
   EXPECT_GE(bodies_that_stand(scene, 3, 9, 0.03), 20);
 }
 
+// Counts, over 20 seeds, the stacks and the spheres on them. Every sphere lies still on a facet
+// (one face's normal points straight down) at the collision margin over the top of exactly one
+// stack, nearly centred on it, and nothing lies on a sphere.
+std::pair<int, int> stacks_and_spheres_seen(const MoviOptions& options) {
+  int stacks = 0, spheres = 0;
+  for (std::uint64_t seed = 0; seed < 20; ++seed) {
+    const SceneSpec spec = sample_movi_scene(options, trajectory_seed(6, seed));
+    const double margin = spec.collision_margin;
+    for (const BodySpec& body : spec.bodies) {
+      stacks += std::abs(lowest(body) - spec.floor->height - margin) < 1e-9;
+      if (body.mesh->name() != "sphere") continue;
+      ++spheres;
+      EXPECT_EQ(body.linear_velocity, Vec3::Zero());
+      EXPECT_EQ(body.angular_velocity, Vec3::Zero());
+      const Points normals =
+          body.mesh->face_normals() * body.pose.orientation.toRotationMatrix().transpose();
+      EXPECT_LT((normals.col(2).array() + 1.0).abs().minCoeff(), 1e-9) << "seed " << seed;
+      const double radius = body.mesh->vertices().rowwise().norm().maxCoeff();
+      int supports = 0;
+      for (const BodySpec& other : spec.bodies) {
+        // Stacks of equal levels have tops at equal heights: only a body under or over the
+        // sphere counts.
+        const double off_axis = (body.pose.position - other.pose.position).head<2>().norm();
+        if (&other == &body || off_axis > radius + half_width(other)) continue;
+        EXPECT_GT(std::abs(lowest(other) - highest(body) - margin), 1e-6)
+            << "a body on a sphere, seed " << seed;
+        if (std::abs(lowest(body) - highest(other) - margin) > 1e-9) continue;
+        EXPECT_LE(off_axis, 0.1 * std::min(radius, half_width(other)) + 1e-9) << "seed " << seed;
+        ++supports;
+      }
+      EXPECT_EQ(supports, 1) << "seed " << seed;
+    }
+  }
+  return {stacks, spheres};
+}
+
+TEST(Generator, SphereToppedStacksRestASphereOnAFacetOfTheTop) {
+  MoviOptions options = stacks_only(2);
+  options.sphere_topped_stacks = 1.0;
+  const auto [stacks, spheres] = stacks_and_spheres_seen(options);
+  EXPECT_EQ(spheres, stacks);
+  EXPECT_GE(stacks, 30);
+  // A share: some stacks topped, some not; none without the option.
+  options.sphere_topped_stacks = 0.5;
+  const auto [half_stacks, half_spheres] = stacks_and_spheres_seen(options);
+  EXPECT_GT(half_spheres, half_stacks / 4);
+  EXPECT_LT(half_spheres, 3 * half_stacks / 4);
+  options.sphere_topped_stacks = 0.0;
+  EXPECT_EQ(stacks_and_spheres_seen(options).second, 0);
+}
+
+// The spheres stay where they lie, as the stacks under them do.
+TEST(Generator, SphereToppedStacksStandInBullet) {
+  MoviOptions scene = stacks_only(3);
+  scene.sphere_topped_stacks = 1.0;
+  EXPECT_GE(bodies_that_stand(scene, 4, 8, 0.02), 16);
+}
+
 // Tossed objects spawn clear of the stacks.
 TEST(Generator, TossedObjectsSpawnClearOfTheStacks) {
   for (std::uint64_t seed = 0; seed < 20; ++seed) {
@@ -373,7 +432,9 @@ TEST(Generator, DatasetInfoRecordsEveryOptionThatShapesTheScenes) {
   options.scene.piles = 3;
   options.scene.min_pile_objects = 2;
   options.scene.max_pile_objects = 9;
-  EXPECT_EQ(dataset_info(options, "9.8.7"), (DatasetInfo{"movi-b", "9.8.7", 19, 2, 4, 6, 3, 2, 9}));
+  options.scene.sphere_topped_stacks = 0.25;
+  EXPECT_EQ(dataset_info(options, "9.8.7"),
+            (DatasetInfo{"movi-b", "9.8.7", 19, 2, 4, 6, 3, 2, 9, 0.25}));
 }
 
 TEST(Generator, BadOptionsAreConfigErrors) {
@@ -422,6 +483,16 @@ TEST(Generator, BadOptionsAreConfigErrors) {
   }
   options = small_options(1);
   options.scene.piles = -1;
+  EXPECT_THROW(generate_dataset(options), ConfigError);
+  // A share of stacks outside 0-1, or spheres without stacks to top.
+  for (double share : {-0.1, 1.5, std::nan("")}) {
+    options = small_options(1);
+    options.scene.stacks = 1;
+    options.scene.sphere_topped_stacks = share;
+    EXPECT_THROW(generate_dataset(options), ConfigError) << share;
+  }
+  options = small_options(1);
+  options.scene.sphere_topped_stacks = 0.5;
   EXPECT_THROW(generate_dataset(options), ConfigError);
 }
 

@@ -56,7 +56,7 @@ class TrajectoryFile : public testing::TempFolderTest {
 
 TEST_F(TrajectoryFile, WriteThenReadRoundTripsExactly) {
   const auto data = make_data(3);
-  const DatasetInfo written{"movi-a", "0.1.0", 7, 2, 3, 5, 1, 4, 8};
+  const DatasetInfo written{"movi-a", "0.1.0", 7, 2, 3, 5, 1, 4, 8, 0.25};
   write_trajectories(dir_ / "set.h5", data, written);
   DatasetInfo info;
   const auto read = read_trajectories(dir_ / "set.h5", &info);
@@ -84,12 +84,12 @@ TEST_F(TrajectoryFile, WriteThenReadRoundTripsExactly) {
     }
   }
   // A file from before stacks, their levels and piles were options reads as the preset's scenes:
-  // no stacks (1-3 levels when asked) and no piles (3-6 objects when asked).
+  // no stacks (1-3 levels when asked), no spheres on them and no piles (3-6 objects when asked).
   {
     H5::H5File file(std::string(dir_ / "set.h5"), H5F_ACC_RDWR);
     H5::Group root = file.openGroup("/");
     for (const char* name : {"stacks", "min_stack_levels", "max_stack_levels", "piles",
-                             "min_pile_objects", "max_pile_objects"})
+                             "min_pile_objects", "max_pile_objects", "sphere_topped_stacks"})
       root.removeAttr(name);
   }
   read_trajectories(dir_ / "set.h5", &info);
@@ -97,11 +97,13 @@ TEST_F(TrajectoryFile, WriteThenReadRoundTripsExactly) {
   // Shards read back in order.
   write_trajectories(dir_ / "shard1.h5", make_data(2), {"movi-a", "0.1.0", 8});
   EXPECT_EQ(read_trajectories({dir_ / "set.h5", dir_ / "shard1.h5"}).size(), 5u);
-  // A file without piles carries no pile attributes: its bytes are those of before piles existed.
+  // A file without piles or spheres carries no attributes for them: its bytes are those of before
+  // they existed.
   {
     H5::H5File file(std::string(dir_ / "shard1.h5"), H5F_ACC_RDONLY);
     const H5::Group root = file.openGroup("/");
-    for (const char* name : {"piles", "min_pile_objects", "max_pile_objects"})
+    for (const char* name :
+         {"piles", "min_pile_objects", "max_pile_objects", "sphere_topped_stacks"})
       EXPECT_FALSE(root.attrExists(name)) << name;
   }
 }

@@ -25,10 +25,12 @@ def test_generated_trajectories_survive_a_file_round_trip(tmp_path):
             np.testing.assert_array_equal(a.faces(o), b.faces(o))
 
 
-@pytest.mark.parametrize("stacks,levels", [(0, (1, 3)), (2, (1, 3)), (2, (4, 5))])
-def test_generate_gives_what_the_command_line_gives(tmp_path, cli, stacks, levels):
+@pytest.mark.parametrize("stacks,levels,spheres",
+                         [(0, (1, 3), 0.0), (2, (1, 3), 0.0), (2, (4, 5), 0.0), (2, (1, 3), 0.5)])
+def test_generate_gives_what_the_command_line_gives(tmp_path, cli, stacks, levels, spheres):
     path = tmp_path / "cli.h5"
-    level_args = ["--min-stack-levels", str(levels[0]), "--max-stack-levels", str(levels[1])]
+    level_args = ["--min-stack-levels", str(levels[0]), "--max-stack-levels", str(levels[1]),
+                  "--sphere-topped-stacks", str(spheres)]
     subprocess.run(
         [cli, "generate", "--preset", "movi-a", "--count", "2", "--seed", "7", "--frames", "10",
          "--stacks", str(stacks), *(level_args if stacks else []), "--out", path],
@@ -36,7 +38,8 @@ def test_generate_gives_what_the_command_line_gives(tmp_path, cli, stacks, level
     )
     from_cli = fignet.read_trajectories(path)
     from_python = fignet.generate("movi-a", count=2, seed=7, frames=10, threads=1, stacks=stacks,
-                                  min_stack_levels=levels[0], max_stack_levels=levels[1])
+                                  min_stack_levels=levels[0], max_stack_levels=levels[1],
+                                  sphere_topped_stacks=spheres)
     assert len(from_cli) == len(from_python) == 2
     for a, b in zip(from_cli, from_python):
         assert a.num_objects == b.num_objects

@@ -199,6 +199,9 @@ void write_trajectories(const std::filesystem::path& path, std::span<const Traje
       hdf5::write_attribute(root, "max_pile_objects",
                             static_cast<long long>(info.max_pile_objects));
     }
+    if (info.sphere_topped_stacks > 0.0) {
+      hdf5::write_attribute(root, "sphere_topped_stacks", info.sphere_topped_stacks);
+    }
     hdf5::write_attribute(root, "num_trajectories", static_cast<long long>(trajectories.size()));
     H5::Group group = hdf5::create_group(file, "trajectories");
     for (size_t i = 0; i < trajectories.size(); ++i) {
@@ -239,6 +242,8 @@ long long read_file(const std::filesystem::path& path, DatasetInfo* info, long l
       info->piles = static_cast<int>(hdf5::read_integer_or(root, "piles", 0));
       info->min_pile_objects = static_cast<int>(hdf5::read_integer_or(root, "min_pile_objects", 3));
       info->max_pile_objects = static_cast<int>(hdf5::read_integer_or(root, "max_pile_objects", 6));
+      // Files written before spheres topped stacks hold none.
+      info->sphere_topped_stacks = hdf5::read_double_or(root, "sphere_topped_stacks", 0.0);
     }
     const long long count = hdf5::read_integer(root, "num_trajectories");
     const H5::Group group = file.openGroup("trajectories");

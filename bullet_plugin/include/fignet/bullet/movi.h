@@ -26,6 +26,11 @@ struct MoviOptions {
   // Levels per stack, uniform in this range (at most kMaxStackLevels). 1–3 is what the stacks
   // data of issue 14 used; taller stacks put more of the data's rest on other bodies.
   int min_stack_levels = 1, max_stack_levels = 3;
+  // Share (0–1) of the stacks topped with a MOVi sphere resting still on one of its facets. Round
+  // bodies roll off piles and MOVi throws every body, so without these no sphere in the data rests
+  // on another body (the stress suite's "MOVi sphere on a MOVi cube"). Drawn from a generator of
+  // their own; 0 keeps the stacks bit for bit.
+  double sphere_topped_stacks = 0.0;
   // Settled piles when the scene starts, this many per scene: min_pile_objects–max_pile_objects
   // of the preset's objects dropped in a narrow column and settled by Bullet before the first
   // frame, so bodies lean on one another and on the floor at odd angles, which neither MOVi nor
@@ -57,14 +62,16 @@ struct MoviOptions {
 // high (uniform), each level a cube or an upright cylinder
 // of the preset's scales and materials, turned by a uniform angle about the vertical, shifted by
 // at most a tenth of the smaller of its and its support's half-widths, and resting on its support
-// at the collision margin. options.piles adds settled piles (a variant, not MOVi): each of
-// min_pile_objects–max_pile_objects (uniform) objects drawn as the tossed ones are (shape, scale,
-// material), at random orientations, one above the other with up to 0.3 m of horizontal jitter,
-// dropped into a 5.8 m square bin of still walls and settled by Bullet for 3 s, then 3 s more
-// without the bin (each run from the last one's poses, still), then moved whole to a uniform spot
-// in (−4,−4)–(4,4) clear of the bodies before it (≤ 100 tries, else left out), still. Throws
-// ConfigError for a bad option,
-// FileError or MeshError for a bad asset folder or file.
+// at the collision margin; a share options.sphere_topped_stacks of them (uniform draw) carry one
+// more level, a sphere of the preset's scales and materials resting on a uniformly drawn facet,
+// turned by a uniform angle about the vertical and shifted as the levels are. options.piles adds
+// settled piles (a variant, not MOVi): each of min_pile_objects–max_pile_objects (uniform) objects
+// drawn as the tossed ones are (shape, scale, material), at random orientations, one above the
+// other with up to 0.3 m of horizontal jitter, dropped into a 5.8 m square bin of still walls and
+// settled by Bullet for 3 s, then 3 s more without the bin (each run from the last one's poses,
+// still), then moved whole to a uniform spot in (−4,−4)–(4,4) clear of the bodies before it (≤ 100
+// tries, else left out), still. Throws ConfigError for a bad option, FileError or MeshError for a
+// bad asset folder or file.
 SceneSpec sample_movi_scene(const MoviOptions& options, std::uint64_t seed);
 
 // The MIT-pushing stand-in (seed B.2, facts §2) of `seed`: a planar prism (rectangle, triangle,

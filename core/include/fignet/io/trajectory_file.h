@@ -24,6 +24,7 @@ struct DatasetInfo {
   int min_stack_levels = 1, max_stack_levels = 3;  // levels per stack (generate --*-stack-levels)
   int piles = 0;  // settled piles at rest per scene (generate --piles)
   int min_pile_objects = 3, max_pile_objects = 6;  // objects per pile (generate --*-pile-objects)
+  double sphere_topped_stacks = 0.0;  // share of stacks a sphere tops (--sphere-topped-stacks)
 
   bool operator==(const DatasetInfo&) const = default;
 };
