@@ -152,11 +152,12 @@ Vec3 off_axis_shift(double half_width, double support_half_width, std::mt19937_6
   return Vec3(reach * std::cos(angle), reach * std::sin(angle), 0.0);
 }
 
-// A MOVi sphere of the preset's scales and materials resting still on `support`'s flat top at
-// the collision margin, on a facet drawn uniformly: turned so that facet faces straight down (each
-// facet of a sphere mesh holds the centre of mass above it, so Bullet holds it there), then by a
-// uniform angle about the vertical, and shifted off the support's axis as a stack's levels are.
-BodySpec sphere_on_top(const BodySpec& support, double support_half_width,
+// A MOVi sphere of the preset's scales and materials resting still on the flat top (at height
+// `support_top`) of a stack's top level, centred at `support_center`, at the collision margin, on a
+// facet drawn uniformly: turned so that facet faces straight down (each facet of a sphere mesh
+// holds the centre of mass above it, so Bullet holds it there), then by a uniform angle about the
+// vertical, and shifted off the support's axis as a stack's levels are.
+BodySpec sphere_on_top(const Vec3& support_center, double support_half_width, double support_top,
                        const MoviOptions& options, bool movi_a, double margin,
                        std::mt19937_64& rng) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -172,12 +173,11 @@ BodySpec sphere_on_top(const BodySpec& support, double support_half_width,
   sphere.pose.orientation = Eigen::AngleAxisd(yaw, Vec3::UnitZ()) *
                             Eigen::Quaterniond::FromTwoVectors(facet_normal, -Vec3::UnitZ()) *
                             sphere.pose.orientation;
-  sphere.pose.position = support.pose.position + off_axis_shift(scale, support_half_width, rng);
+  sphere.pose.position = support_center + off_axis_shift(scale, support_half_width, rng);
   // Lowest vertex at the margin over the support's top.
   sphere.pose.position.z() = 0.0;
-  const double top = posed_vertices(*support.mesh, support.pose).col(2).maxCoeff();
   sphere.pose.position.z() =
-      top + margin - posed_vertices(*sphere.mesh, sphere.pose).col(2).minCoeff();
+      support_top + margin - posed_vertices(*sphere.mesh, sphere.pose).col(2).minCoeff();
   return sphere;
 }
 
@@ -218,8 +218,8 @@ void add_stacks(const MoviOptions& options, bool movi_a, std::uint64_t seed, Sce
       stack.push_back(std::move(body));
     }
     if (unit(sphere_rng) < options.sphere_topped_stacks) {
-      stack.push_back(
-          sphere_on_top(stack.back(), half_widths.back(), options, movi_a, margin, sphere_rng));
+      stack.push_back(sphere_on_top(below_center, half_widths.back(), top, options, movi_a, margin,
+                                    sphere_rng));
     }
     place_clear(stack, rng, spec, placed);
   }
