@@ -10,6 +10,11 @@
 //   peak_gflops    the processor's fp32 peak: independent FMA chains on the widest vectors it
 //                  has (AVX-512 or AVX2, chosen at run time) on every thread; of_peak = gflops /
 //                  peak
+//   bare_ms        the very products one iteration ran (recorded by GemmLog: shapes, layouts,
+//                  bias and ReLU), run bare on the same threads, as a batch's are when chunked;
+//                  of_bare = bare_ms / the iteration's ms: the share of the time that is products
+//                  at the speed they have alone. product_gflop: their exact FLOPs per iteration
+//                  (gflop is the count above: 3x the forward for training)
 // BM_TrainingBatch trains on a batch of 16 scenes as `fignet train` does and reports samples/s:
 // "whole_eigen" is the path before the CPU backend work (the batch as one graph, Eigen products
 // threaded one by one), "chunked" the CPU backend (chunks of scenes in parallel, the build's
@@ -31,6 +36,7 @@
 #include "fignet/model/model.h"
 #include "fignet/model/network_backend.h"
 #include "fignet/nn/gemm.h"
+#include "fignet/nn/gemm_log.h"
 #include "fignet/scenes/resting_lattice.h"
 #include "fignet/train/training_batch.h"
 
@@ -152,6 +158,24 @@ void add_references(benchmark::State& state, double achieved, Eigen::Index mesh_
   state.counters["of_peak"] = achieved / peak;
 }
 
+// The products of one call of `iteration`, run bare: their exact FLOPs and what share of an
+// iteration's `seconds` they take alone.
+template <class F>
+void add_bare_products(benchmark::State& state, F&& iteration, double seconds, bool share_out) {
+  std::vector<GemmShape> shapes;
+  {
+    const GemmLog log;
+    iteration();
+    shapes = log.shapes();
+  }
+  double flops = 0.0;
+  for (const GemmShape& shape : shapes) flops += shape.flops();
+  const double bare = time_gemm_shapes(shapes, 0.2, share_out);
+  state.counters["product_gflop"] = flops / 1e9;
+  state.counters["bare_ms"] = 1e3 * bare;
+  state.counters["of_bare"] = bare / seconds;
+}
+
 void report(benchmark::State& state, const Setup& s, double flops_per_iteration,
             double loop_seconds, int threads) {
   state.counters["mesh_nodes"] = s.graph.num_mesh_nodes();
@@ -175,8 +199,15 @@ void BM_Inference(benchmark::State& state, const char* preset) {
                                           s.graph, workspace, false)
                                  .data());
   }
-  report(state, s, network.forward_flops(s.graph), seconds_since(start),
-         static_cast<int>(state.range(0)));
+  const double seconds = seconds_since(start);
+  report(state, s, network.forward_flops(s.graph), seconds, static_cast<int>(state.range(0)));
+  add_bare_products(
+      state,
+      [&] {
+        network.forward(s.model->parameters().data(), s.model->normalizers(), s.graph, workspace,
+                        false);
+      },
+      seconds / state.iterations(), false);
   Eigen::setNbThreads(0);
 }
 
@@ -187,15 +218,18 @@ void BM_TrainingStep(benchmark::State& state, const char* preset) {
   const Network& network = s.model->network();
   std::vector<float> grads(s.model->parameters().size());
   const RowMatrixXf d_output = RowMatrixXf::Ones(s.graph.num_mesh_nodes(), 3);
-  const auto start = std::chrono::steady_clock::now();
-  for (auto _ : state) {
+  auto step = [&] {
     network.forward(s.model->parameters().data(), s.model->normalizers(), s.graph, workspace, true);
     std::fill(grads.begin(), grads.end(), 0.0f);
     network.backward(s.model->parameters().data(), grads.data(), s.graph, d_output, workspace);
     benchmark::DoNotOptimize(grads.data());
-  }
-  report(state, s, 3.0 * network.forward_flops(s.graph), seconds_since(start),  // bwd ≈ 2 fwd
+  };
+  const auto start = std::chrono::steady_clock::now();
+  for (auto _ : state) step();
+  const double seconds = seconds_since(start);
+  report(state, s, 3.0 * network.forward_flops(s.graph), seconds,  // bwd ≈ 2 fwd
          static_cast<int>(state.range(0)));
+  add_bare_products(state, step, seconds / state.iterations(), false);
   Eigen::setNbThreads(0);
 }
 
@@ -267,6 +301,9 @@ void BM_TrainingBatch(benchmark::State& state, const char* preset, BatchPath pat
   const double achieved = 3.0 * network.forward_flops(graph) * state.iterations() / seconds / 1e9;
   add_references(state, achieved, graph.mesh_edges.size() / kScenes, model.config().latent_size,
                  threads);
+  if (bf16) set_gemm_precision(GemmPrecision::kBf16);
+  add_bare_products(state, step, seconds / state.iterations(), chunked);
+  if (bf16) set_gemm_precision(GemmPrecision::kF32);
   Eigen::setNbThreads(0);
   set_gemm_engine(engine);
 }

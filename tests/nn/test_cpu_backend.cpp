@@ -12,6 +12,7 @@
 #include "fignet/model/network_backend.h"
 #include "fignet/nn/gemm.h"
 #include "fignet/scenes/resting_lattice.h"
+#include "movi_lattices.h"
 
 namespace fignet {
 namespace {
@@ -27,16 +28,8 @@ struct Batch {
   RowMatrixXf weights;  // the loss is Σ weights·output
 
   Batch() {
-    std::vector<Scene> scenes;
-    for (unsigned s = 0; s < 8; ++s) {
-      RestingLatticeOptions options;
-      options.objects = 6;
-      options.seed = s + 1;
-      options.scales = {0.7, 1.4};
-      lattices.push_back(make_resting_lattice(options));
-    }
-    for (const auto& l : lattices) scenes.push_back(l.scene);
-    GraphBuilder(network.config().graph).build(scenes, graph);
+    lattices = testing::movi_a_lattices(8, [](int) { return 6; });
+    GraphBuilder(network.config().graph).build(testing::scenes_of(lattices), graph);
     network.layout().initialize(params, 5);
     normalizers = network.make_normalizers();
     network.accumulate_input_statistics(graph, normalizers);

@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "fignet/error.h"
+#include "fignet/nn/gemm_log.h"
 #include "parallel/parallel_for.h"
 
 #ifdef FIGNET_WITH_ONEDNN
@@ -284,6 +285,9 @@ void gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b, Tran
     if (!accumulate) c.setZero();
     return;
   }
+  if (GemmLog* log = detail::live_gemm_log.load(std::memory_order_relaxed)) {
+    log->add({c.rows(), k, c.cols(), op_a, op_b, accumulate, false, Activation::kNone});
+  }
   const GemmEngine engine = current_engine().load(std::memory_order_relaxed);
   if (op_a == Transpose::kYes) {
     weight_gradient(engine, a, b, op_b, c, accumulate);
@@ -310,6 +314,9 @@ void gemm_bias(const ConstMatrixRef& a, const ConstMatrixRef& b, Transpose op_b,
     bias_activation(c, bias, activation, c);
     epilogue(0, c.rows());
     return;
+  }
+  if (GemmLog* log = detail::live_gemm_log.load(std::memory_order_relaxed)) {
+    log->add({c.rows(), k, c.cols(), Transpose::kNo, op_b, false, true, activation});
   }
   row_products(current_engine().load(std::memory_order_relaxed), a, b, op_b, c, false, bias,
                activation, prologue, epilogue);
