@@ -48,16 +48,16 @@ TEST(GemmLog, OneAtATime) {
   EXPECT_EQ(again.shapes().size(), 1u);
 }
 
-// A small-preset network on six MOVi-A-like scenes, random parameters.
+// A small-preset network on `count` MOVi-A-like scenes of 3, 4, ... objects, random parameters.
 struct Scenes {
   Graph graph;
   Network network{ModelConfig::preset_named("small")};
   std::vector<float> params;
   Normalizers normalizers;
 
-  Scenes() {
+  explicit Scenes(int count) {
     const std::vector<RestingLattice> lattices =
-        testing::movi_a_lattices(6, [](int s) { return 3 + s; });
+        testing::movi_a_lattices(count, [](int s) { return 3 + s; });
     GraphBuilder(network.config().graph).build(testing::scenes_of(lattices), graph);
     network.layout().initialize(params, 5);
     normalizers = network.make_normalizers();
@@ -66,7 +66,7 @@ struct Scenes {
 };
 
 TEST(GemmLog, ForwardFlopsAreTheNetworksCount) {
-  const Scenes s;
+  const Scenes s(2);
   ASSERT_GT(s.graph.face_edges.size(), 0u);
   NetworkWorkspace workspace;
   GemmLog log;
@@ -96,7 +96,8 @@ std::vector<GemmShape> batch_products(const Scenes& s, int threads) {
 }
 
 TEST(GemmLog, RecordsEveryThreadsProducts) {
-  const Scenes s;
+  const Scenes s(4);
+  ASSERT_GT(s.graph.num_mesh_nodes(), 1000);  // more than one chunk (up to 1000 nodes each)
   const std::vector<GemmShape> one = batch_products(s, 1), two = batch_products(s, 2);
   EXPECT_EQ(one, two);
   // The backward pass does about twice the forward's arithmetic (a weight and an input gradient
