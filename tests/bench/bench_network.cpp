@@ -32,6 +32,7 @@
 #include <chrono>
 #include <string>
 
+#include "../movi_lattices.h"
 #include "fignet/graph/graph_builder.h"
 #include "fignet/model/model.h"
 #include "fignet/model/network_backend.h"
@@ -134,11 +135,7 @@ struct Setup {
 
 Setup make_setup(const char* preset) {
   Setup s;
-  RestingLatticeOptions options;
-  options.objects = 6;
-  options.seed = 1;
-  options.scales = {0.7, 1.4};  // MOVi-A sizes
-  s.lattice = make_resting_lattice(options);
+  s.lattice = testing::movi_a_lattices(1, [](int) { return 6; }).front();
   const ModelConfig config = ModelConfig::preset_named(preset);
   s.model = std::make_shared<Model>(config);
   GraphBuilder(config.graph).build(s.lattice.scene, s.graph);
@@ -249,16 +246,10 @@ void BM_TrainingBatch(benchmark::State& state, const char* preset, BatchPath pat
     }
   }
   constexpr int kScenes = 16;
-  std::vector<RestingLattice> lattices;
-  std::vector<Scene> scenes;
-  for (int i = 0; i < kScenes; ++i) {
-    RestingLatticeOptions options;
-    options.objects = 3 + i % 8;  // MOVi-A: 3 to 10 objects
-    options.seed = i + 1;
-    options.scales = {0.7, 1.4};
-    lattices.push_back(make_resting_lattice(options));
-  }
-  for (const auto& l : lattices) scenes.push_back(l.scene);
+  // MOVi-A: 3 to 10 objects.
+  const std::vector<RestingLattice> lattices =
+      testing::movi_a_lattices(kScenes, [](int s) { return 3 + s % 8; });
+  const std::vector<Scene> scenes = testing::scenes_of(lattices);
   const Model model(ModelConfig::preset_named(preset));
   const Network& network = model.network();
   Graph graph;

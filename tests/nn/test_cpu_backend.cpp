@@ -7,12 +7,12 @@
 #include <random>
 #include <string>
 
+#include "../movi_lattices.h"
 #include "../scoped_threads.h"
 #include "fignet/graph/graph_builder.h"
 #include "fignet/model/network_backend.h"
 #include "fignet/nn/gemm.h"
 #include "fignet/scenes/resting_lattice.h"
-#include "movi_lattices.h"
 
 namespace fignet {
 namespace {

@@ -7,12 +7,12 @@
 #include <cmath>
 #include <tuple>
 
+#include "../movi_lattices.h"
 #include "../scoped_threads.h"
 #include "fignet/error.h"
 #include "fignet/graph/graph_builder.h"
 #include "fignet/model/network_backend.h"
 #include "fignet/nn/gemm_log.h"
-#include "movi_lattices.h"
 
 namespace fignet {
 namespace {
