@@ -1,5 +1,5 @@
-// Scenes for the network's tests: MOVi-A-like resting lattices (bodies 0.7–1.4 m across), one
-// per seed 1, 2, ...
+// Scenes for the network's tests and benchmarks: MOVi-A-like resting lattices (bodies 0.7–1.4 m
+// across), one per seed 1, 2, ...
 #pragma once
 
 #include <cstdint>
