@@ -135,7 +135,8 @@ struct Setup {
 
 Setup make_setup(const char* preset) {
   Setup s;
-  s.lattice = testing::movi_a_lattices(1, [](int) { return 6; }).front();
+  std::vector<RestingLattice> one = testing::movi_a_lattices(1, [](int) { return 6; });
+  s.lattice = std::move(one.front());  // a lattice owns its meshes: moved, not copied
   const ModelConfig config = ModelConfig::preset_named(preset);
   s.model = std::make_shared<Model>(config);
   GraphBuilder(config.graph).build(s.lattice.scene, s.graph);
