@@ -61,9 +61,11 @@ TrainingConfig resolve_config(const TrainArgs& args) {
   }
   for (const std::string& setting : args.settings) config.apply_setting(setting);
   if (args.steps >= 0) config.steps = args.steps;
-  // The learning rate decays over the run's length unless decay_steps was given.
+  // The learning rate decays over the run's length (from decay_start_step) unless decay_steps
+  // was given.
   if (!config.decay_steps_given) {
-    config.trainer.adam.decay_steps = std::max<std::int64_t>(1, config.steps);
+    config.trainer.adam.decay_steps =
+        std::max<std::int64_t>(1, config.steps - config.trainer.adam.decay_start_step);
   }
   return config;
 }

@@ -45,6 +45,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   trainer_config.batch_size = 2;
   trainer_config.seed = 7;
   trainer_config.adam.decay_steps = 20;
+  trainer_config.adam.decay_start_step = 3;  // the resumed run's rate must decay from step 3
   trainer_config.rest_loss_weight = 30.0f;
   trainer_config.still_air_fraction = 0.5f;
   trainer_config.pushforward_fraction = 0.5f;
@@ -61,6 +62,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   EXPECT_EQ(checkpoint.planned_steps, 10);
   EXPECT_EQ(checkpoint.trainer_config.batch_size, 2);
   EXPECT_EQ(checkpoint.trainer_config.adam.decay_steps, 20);
+  EXPECT_EQ(checkpoint.trainer_config.adam.decay_start_step, 3);
   EXPECT_EQ(checkpoint.trainer_config.rest_loss_weight, 30.0f);
   EXPECT_EQ(checkpoint.trainer_config.still_air_fraction, 0.5f);
   EXPECT_EQ(checkpoint.trainer_config.pushforward_fraction, 0.5f);

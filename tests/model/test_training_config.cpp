@@ -108,6 +108,10 @@ TEST(TrainingConfig, BadInputNamesTheField) {
             std::string::npos);
   config.model.friction = {};
   EXPECT_NO_THROW(config.validate());
+  config.apply_setting("decay_start_step=-1");
+  EXPECT_NE(error_of([&] { config.validate(); }).find("decay_start_step = -1 (must be >= 0)"),
+            std::string::npos);
+  config.apply_setting("decay_start_step=0");
   config.apply_setting("pushforward_steps=9");
   EXPECT_NE(error_of([&] { config.validate(); }).find("pushforward_steps = 9 (must be in 1..8"),
             std::string::npos);

@@ -207,6 +207,24 @@ TEST(Adam, DecaysTheLearningRateExponentiallyAndMinimisesAQuadratic) {
   EXPECT_LT(std::abs(x[0]) + std::abs(x[1]), 0.05f);
 }
 
+// A continuation restarts the decay: the start rate up to decay_start_step, the same curve
+// shifted by it, and the end rate from decay_start_step + decay_steps on.
+TEST(Adam, StartsTheDecayAtDecayStartStep) {
+  Adam adam(1, {.learning_rate_start = 2e-4f,
+                .learning_rate_end = 5e-5f,
+                .decay_steps = 10,
+                .decay_start_step = 1000});
+  const auto rate_at = [&](std::int64_t step) {
+    adam.set_step(step);
+    return adam.learning_rate();
+  };
+  EXPECT_FLOAT_EQ(rate_at(0), 2e-4f);
+  EXPECT_FLOAT_EQ(rate_at(1000), 2e-4f);
+  EXPECT_NEAR(rate_at(1005), 1e-4f, 1e-9f);  // halfway: the geometric mean of 2e-4 and 5e-5
+  EXPECT_FLOAT_EQ(rate_at(1010), 5e-5f);
+  EXPECT_FLOAT_EQ(rate_at(5000), 5e-5f);
+}
+
 // The update runs on the threads in fixed blocks: the same bits for 1 and 3 threads, over
 // several blocks and a partial one, and each parameter as Adam's formula in double precision
 // gives it (to float rounding).

@@ -19,6 +19,7 @@ void write_training(H5::Group group, const TrainerConfig& config, const TrainerS
   write_attribute(group, "learning_rate_start", double{config.adam.learning_rate_start});
   write_attribute(group, "learning_rate_end", double{config.adam.learning_rate_end});
   write_attribute(group, "decay_steps", static_cast<long long>(config.adam.decay_steps));
+  write_attribute(group, "decay_start_step", static_cast<long long>(config.adam.decay_start_step));
   write_attribute(group, "gradient_clip", double{config.gradient_clip});
   write_attribute(group, "huber_delta", double{config.huber_delta});
   write_attribute(group, "statistics_warmup", static_cast<long long>(config.statistics_warmup));
@@ -51,6 +52,8 @@ void read_training(const H5::Group& group, size_t parameters, const std::string&
   auto read_float_or = [&](const char* name, float absent) {
     return static_cast<float>(read_double_or(group, name, absent));
   };
+  config.adam.decay_start_step =
+      read_integer_or(group, "decay_start_step", config.adam.decay_start_step);
   config.gradient_clip = read_float_or("gradient_clip", config.gradient_clip);
   config.huber_delta = read_float_or("huber_delta", config.huber_delta);
   config.statistics_warmup =

@@ -16,7 +16,9 @@ Adam::Adam(size_t num_parameters, const AdamConfig& config)
 
 float Adam::learning_rate() const {
   const double progress =
-      std::min(1.0, static_cast<double>(step_) / std::max<std::int64_t>(1, config_.decay_steps));
+      std::clamp(static_cast<double>(step_ - config_.decay_start_step) /
+                     static_cast<double>(std::max<std::int64_t>(1, config_.decay_steps)),
+                 0.0, 1.0);
   return static_cast<float>(
       config_.learning_rate_start *
       std::pow(config_.learning_rate_end / config_.learning_rate_start, progress));

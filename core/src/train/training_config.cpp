@@ -120,6 +120,9 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.adam.learning_rate_end; })},
       {"decay_steps",
        plain<std::int64_t>([](TrainingConfig & c) -> auto& { return c.trainer.adam.decay_steps; })},
+      {"decay_start_step", plain<std::int64_t>([](TrainingConfig & c) -> auto& {
+         return c.trainer.adam.decay_start_step;
+       })},
       {"gradient_clip",
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.gradient_clip; })},
       {"huber_delta",
@@ -310,6 +313,9 @@ void TrainingConfig::validate() const {
   }
   if (adam.decay_steps < 1) {
     throw ConfigError(fmt::format("decay_steps = {} (must be >= 1)", adam.decay_steps));
+  }
+  if (adam.decay_start_step < 0) {
+    throw ConfigError(fmt::format("decay_start_step = {} (must be >= 0)", adam.decay_start_step));
   }
   if (steps < 0) throw ConfigError(fmt::format("steps = {} (must be >= 0)", steps));
   for (const auto& [name, value] : {std::pair("gradient_clip", trainer.gradient_clip),

@@ -1,5 +1,6 @@
 // Adam over a flat parameter array, with the seed's exponential learning-rate decay
-// (1e-3 to 1e-4 over the configured number of steps, then held).
+// (1e-3 to 1e-4 over the configured number of steps, then held). The decay may start at a later
+// step: a continuation of a finished run restarts from a higher rate that way.
 #pragma once
 
 #include <cstddef>
@@ -13,6 +14,8 @@ struct AdamConfig {
   float learning_rate_start = 1e-3f;
   float learning_rate_end = 1e-4f;
   std::int64_t decay_steps = 1'000'000;
+  // The step the decay starts from: the start rate up to it, the end rate from it + decay_steps.
+  std::int64_t decay_start_step = 0;
   float beta1 = 0.9f, beta2 = 0.999f, epsilon = 1e-8f;
 };
 
