@@ -171,18 +171,23 @@ def test_turn_averaging_cancels_the_models_sideways_push_at_rest(model):
     # (FIGNetWorldOptions::turns; the exact cancellation of a constant bias is ModelPredictor's
     # C++ test). The body is the data's own (a 1.4 m metal cube of 7.4 kg on Kubric's floor,
     # resting 5 mm up where Bullet's margin rests it): outside the data's materials a model's push
-    # is its guess. Over 48 steps the shipped models moved it 0.5-0.7 mm with one turn, 0.2-0.6
-    # of that with two: a ratio near 1 would say the turns never reached the predictor.
-    moved = {}
+    # is its guess. Over 48 steps from (0.2, -0.1) the models shipped to 2026-11-29 moved it
+    # 0.5-0.7 mm with one turn and 0.2-0.6 of that with two; the model of 2026-12-03 pushes 4-5x
+    # less, too little to cancel in 48 steps (0.13 mm, ratio 1.1), and from the origin over 192
+    # steps moves it 0.50 mm with one turn and 0.65 of that with two. A ratio near 1 would say
+    # the turns never reached the predictor; unequal runs, that they ran at all.
+    moved, ends = {}, {}
     for turns in (1, 2):
         scene = fignet.Scene(model, free_flight=False, sleeping=False, penetration_guard=False,
                              rest_guard=False, turns=turns)
         scene.add_floor()
         vertices, faces = box(0.7)
-        start = np.array([0.2, -0.1, 0.705])
+        start = np.array([0.0, 0.0, 0.705])
         scene.add_body(vertices, faces, mass=7.4, friction=0.4, restitution=0.3, position=start)
-        scene.step(48)
-        moved[turns] = np.linalg.norm(scene.positions[0, :2] - start[:2])
+        scene.step(192)
+        ends[turns] = scene.positions[0].copy()
+        moved[turns] = np.linalg.norm(ends[turns][:2] - start[:2])
+    assert np.linalg.norm(ends[2] - ends[1]) > 1e-6, ends
     assert moved[2] < 0.8 * moved[1], moved
     with pytest.raises(ValueError, match="turns"):
         fignet.Scene(model, turns=0).step(1)
