@@ -15,6 +15,14 @@
 //                  of_bare = bare_ms / the iteration's ms: the share of the time that is products
 //                  at the speed they have alone. product_gflop: their exact FLOPs per iteration
 //                  (gflop is the count above: 3x the forward for training)
+//   in_step_ms     the same products timed where they ran, inside the iteration (mean of 8
+//                  calls; shared out, summed over the threads and divided by their number);
+//                  of_in_step = in_step_ms / the iteration's ms. weight_grad_slowdown and
+//                  other_slowdown: the weight gradients' (aᵀ·b) and the other products' time in
+//                  the iteration over their time bare, leaving out products whose blocks carry
+//                  fused row passes (LayerNorm), which bare runs without. Above 1: operands the
+//                  step left out of cache (the forward's activations, read again by the backward)
+// FIGNET_PRODUCTS_CSV=file appends every product's shape and its in-step and bare microseconds.
 // BM_TrainingBatch trains on a batch of 16 scenes as `fignet train` does and reports samples/s:
 // "whole_eigen" is the path before the CPU backend work (the batch as one graph, Eigen products
 // threaded one by one), "chunked" the CPU backend (chunks of scenes in parallel, the build's
@@ -30,6 +38,8 @@
 
 #include <Eigen/Core>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "../movi_lattices.h"
@@ -156,22 +166,87 @@ void add_references(benchmark::State& state, double achieved, Eigen::Index mesh_
   state.counters["of_peak"] = achieved / peak;
 }
 
+// Appends one line per product of an iteration to the CSV file at `path`: its shape, layouts and
+// its mean microseconds inside the iteration (`in_step` holds several calls' products in turn)
+// and bare.
+void write_products_csv(const char* path, const std::string& benchmark,
+                        const std::vector<GemmShape>& shapes, const std::vector<double>& in_step,
+                        const std::vector<bool>& row_passes, const std::vector<double>& bare) {
+  std::FILE* file = std::fopen(path, "a");
+  if (file == nullptr) {
+    std::fprintf(stderr, "FIGNET_PRODUCTS_CSV: cannot open %s for appending\n", path);
+    return;
+  }
+  const size_t count = shapes.size(), calls = in_step.size() / count;
+  if (std::ftell(file) == 0) {
+    std::fprintf(file,
+                 "benchmark,index,m,k,n,a_transposed,b_transposed,accumulate,bias,"
+                 "row_passes,in_step_us,bare_us\n");
+  }
+  for (size_t j = 0; j < count; ++j) {
+    double seconds = 0.0;
+    for (size_t call = 0; call < calls; ++call) seconds += in_step[call * count + j] / calls;
+    const GemmShape& g = shapes[j];
+    std::fprintf(file, "%s,%zu,%ld,%ld,%ld,%d,%d,%d,%d,%d,%.3f,%.3f\n", benchmark.c_str(), j,
+                 static_cast<long>(g.m), static_cast<long>(g.k), static_cast<long>(g.n),
+                 g.op_a == Transpose::kYes, g.op_b == Transpose::kYes, g.accumulate, g.bias,
+                 static_cast<bool>(row_passes[j]), 1e6 * seconds, 1e6 * bare[j]);
+  }
+  std::fclose(file);
+}
+
 // The products of one call of `iteration`, run bare: their exact FLOPs and what share of an
-// iteration's `seconds` they take alone.
+// iteration's `seconds` they take alone; and the same products timed inside the iteration (over a
+// few calls), set against their bare times: how much slower they run among the passes.
 template <class F>
-void add_bare_products(benchmark::State& state, F&& iteration, double seconds, bool share_out) {
-  std::vector<GemmShape> shapes;
-  double flops = 0.0;
+void add_bare_products(benchmark::State& state, const std::string& label, F&& iteration,
+                       double seconds, bool share_out) {
+  constexpr int kLoggedCalls = 8;
+  std::vector<GemmShape> logged;
+  std::vector<double> in_step;
+  std::vector<bool> row_passes;
   {
     const GemmLog log;
-    iteration();
-    shapes = log.shapes();
-    flops = log.flops();
+    for (int i = 0; i < kLoggedCalls; ++i) iteration();
+    logged = log.shapes();
+    in_step = log.seconds();
+    row_passes = log.with_row_passes();
   }
-  const double bare = time_gemm_shapes(shapes, 0.2, share_out);
+  const size_t count = logged.size() / kLoggedCalls;
+  const std::vector<GemmShape> shapes(logged.begin(), logged.begin() + count);
+  double flops = 0.0;
+  for (const GemmShape& g : shapes) flops += g.flops();
+  std::vector<double> bare_each;
+  const double bare = time_gemm_shapes(shapes, 0.2, share_out, &bare_each);
+  // Sums per iteration over the products, split into weight gradients (aᵀ·b) and the rest; the
+  // products with passes fused into their blocks are left out of the in-step comparison. Shared
+  // out, a call's products start in any order, so the sums go by kind, not by position.
+  double step_weight = 0.0, bare_weight = 0.0, step_rest = 0.0, bare_rest = 0.0, step_all = 0.0;
+  for (size_t i = 0; i < logged.size(); ++i) {
+    step_all += in_step[i] / kLoggedCalls;
+    if (row_passes[i]) continue;
+    (logged[i].op_a == Transpose::kYes ? step_weight : step_rest) += in_step[i] / kLoggedCalls;
+  }
+  for (size_t j = 0; j < count; ++j) {
+    if (row_passes[j]) continue;
+    (shapes[j].op_a == Transpose::kYes ? bare_weight : bare_rest) += bare_each[j];
+  }
+  if (const char* path = std::getenv("FIGNET_PRODUCTS_CSV")) {
+    // One thread runs every call's products in the same order; shared out, only the first
+    // call's times line up with `shapes`.
+    const size_t calls = share_out ? 1 : kLoggedCalls;
+    write_products_csv(path, label, shapes,
+                       std::vector<double>(in_step.begin(), in_step.begin() + calls * count),
+                       row_passes, bare_each);
+  }
+  const double threads = share_out ? Eigen::nbThreads() : 1;
   state.counters["product_gflop"] = flops / 1e9;
   state.counters["bare_ms"] = 1e3 * bare;
   state.counters["of_bare"] = bare / seconds;
+  state.counters["in_step_ms"] = 1e3 * step_all / threads;
+  state.counters["of_in_step"] = step_all / threads / seconds;
+  state.counters["weight_grad_slowdown"] = bare_weight > 0.0 ? step_weight / bare_weight : 0.0;
+  state.counters["other_slowdown"] = bare_rest > 0.0 ? step_rest / bare_rest : 0.0;
 }
 
 void report(benchmark::State& state, const Setup& s, double flops_per_iteration,
@@ -200,7 +275,7 @@ void BM_Inference(benchmark::State& state, const char* preset) {
   const double seconds = seconds_since(start);
   report(state, s, network.forward_flops(s.graph), seconds, static_cast<int>(state.range(0)));
   add_bare_products(
-      state,
+      state, std::string("Inference/") + preset + "/" + std::to_string(state.range(0)),
       [&] {
         network.forward(s.model->parameters().data(), s.model->normalizers(), s.graph, workspace,
                         false);
@@ -227,7 +302,9 @@ void BM_TrainingStep(benchmark::State& state, const char* preset) {
   const double seconds = seconds_since(start);
   report(state, s, 3.0 * network.forward_flops(s.graph), seconds,  // bwd ≈ 2 fwd
          static_cast<int>(state.range(0)));
-  add_bare_products(state, step, seconds / state.iterations(), false);
+  add_bare_products(state,
+                    std::string("TrainingStep/") + preset + "/" + std::to_string(state.range(0)),
+                    step, seconds / state.iterations(), false);
   Eigen::setNbThreads(0);
 }
 
@@ -294,7 +371,13 @@ void BM_TrainingBatch(benchmark::State& state, const char* preset, BatchPath pat
   add_references(state, achieved, graph.mesh_edges.size() / kScenes, model.config().latent_size,
                  threads);
   if (bf16) set_gemm_precision(GemmPrecision::kBf16);
-  add_bare_products(state, step, seconds / state.iterations(), chunked);
+  add_bare_products(state,
+                    std::string("TrainingBatch/") + preset +
+                        (!chunked ? "_whole_eigen/"
+                         : bf16   ? "_chunked_bf16/"
+                                  : "_chunked/") +
+                        std::to_string(threads),
+                    step, seconds / state.iterations(), chunked);
   if (bf16) set_gemm_precision(GemmPrecision::kF32);
   Eigen::setNbThreads(0);
   set_gemm_engine(engine);

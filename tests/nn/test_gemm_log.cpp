@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <numeric>
+#include <thread>
 #include <tuple>
 
 #include "../movi_lattices.h"
@@ -34,6 +37,30 @@ TEST(GemmLog, RecordsEachProductAsAsked) {
   };
   EXPECT_EQ(log.shapes(), expected);
   EXPECT_DOUBLE_EQ(log.flops(), 2.0 * (7 * 5 * 3 + 5 * 7 * 3 + 7 * 5 * 3));
+  EXPECT_EQ(log.with_row_passes(), std::vector<bool>(3, false));
+  const std::vector<double> seconds = log.seconds();
+  ASSERT_EQ(seconds.size(), 3u);
+  for (const double s : seconds) {
+    EXPECT_GT(s, 0.0);
+    EXPECT_LT(s, 1.0);
+  }
+}
+
+// A product with a pass fused into its blocks is marked, and its time includes the pass's.
+TEST(GemmLog, MarksProductsWithRowPasses) {
+  const RowMatrixXf a = RowMatrixXf::Random(300, 8), b = RowMatrixXf::Random(8, 4);
+  RowMatrixXf c(300, 4);
+  const std::vector<float> bias(4, 0.0f);
+  struct Slow {
+    static void run(const void*, Eigen::Index, Eigen::Index) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  };
+  GemmLog log;
+  gemm_bias(a, b, Transpose::kNo, bias.data(), Activation::kNone, c, {}, {&Slow::run, nullptr});
+  gemm_bias(a, b, Transpose::kNo, bias.data(), Activation::kNone, c);
+  EXPECT_EQ(log.with_row_passes(), (std::vector<bool>{true, false}));
+  EXPECT_GE(log.seconds()[0], 0.002);
 }
 
 TEST(GemmLog, OneAtATime) {
@@ -118,9 +145,16 @@ TEST(GemmLog, BareProductsTakeTime) {
   for (const int threads : {1, 2}) {
     const testing::ScopedEigenThreads scope(threads);
     for (const bool share_out : {false, true}) {
-      const double seconds = time_gemm_shapes(shapes, 0.01, share_out);
+      std::vector<double> each;
+      const double seconds = time_gemm_shapes(shapes, 0.01, share_out, &each);
       EXPECT_GT(seconds, 0.0);
       EXPECT_TRUE(std::isfinite(seconds));
+      ASSERT_EQ(each.size(), shapes.size());
+      for (const double s : each) EXPECT_GT(s, 0.0);
+      // One at a time, the products' times lie inside the pass's.
+      if (!share_out || threads == 1) {
+        EXPECT_LE(std::accumulate(each.begin(), each.end(), 0.0), seconds);
+      }
     }
   }
   EXPECT_EQ(time_gemm_shapes({}, 0.01, false), 0.0);

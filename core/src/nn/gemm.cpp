@@ -285,9 +285,8 @@ void gemm(const ConstMatrixRef& a, Transpose op_a, const ConstMatrixRef& b, Tran
     if (!accumulate) c.setZero();
     return;
   }
-  if (GemmLog* log = detail::live_gemm_log.load(std::memory_order_relaxed)) {
-    log->add({c.rows(), k, c.cols(), op_a, op_b, accumulate, false, Activation::kNone});
-  }
+  const detail::LoggedProduct logged(
+      {c.rows(), k, c.cols(), op_a, op_b, accumulate, false, Activation::kNone});
   const GemmEngine engine = current_engine().load(std::memory_order_relaxed);
   if (op_a == Transpose::kYes) {
     weight_gradient(engine, a, b, op_b, c, accumulate);
@@ -315,9 +314,9 @@ void gemm_bias(const ConstMatrixRef& a, const ConstMatrixRef& b, Transpose op_b,
     epilogue(0, c.rows());
     return;
   }
-  if (GemmLog* log = detail::live_gemm_log.load(std::memory_order_relaxed)) {
-    log->add({c.rows(), k, c.cols(), Transpose::kNo, op_b, false, true, activation});
-  }
+  const detail::LoggedProduct logged(
+      {c.rows(), k, c.cols(), Transpose::kNo, op_b, false, true, activation},
+      prologue.run != nullptr || epilogue.run != nullptr);
   row_products(current_engine().load(std::memory_order_relaxed), a, b, op_b, c, false, bias,
                activation, prologue, epilogue);
 }

@@ -24,9 +24,27 @@ GemmLog::~GemmLog() {
   detail::live_gemm_log.store(nullptr);
 }
 
-void GemmLog::add(const GemmShape& shape) {
+size_t GemmLog::add(const GemmShape& shape, bool row_passes) {
   const std::lock_guard lock(mutex_);
   shapes_.push_back(shape);
+  seconds_.push_back(0.0);
+  row_passes_.push_back(row_passes);
+  return shapes_.size() - 1;
+}
+
+void GemmLog::finish(size_t index, double seconds) {
+  const std::lock_guard lock(mutex_);
+  seconds_.at(index) = seconds;
+}
+
+std::vector<double> GemmLog::seconds() const {
+  const std::lock_guard lock(mutex_);
+  return seconds_;
+}
+
+std::vector<bool> GemmLog::with_row_passes() const {
+  const std::lock_guard lock(mutex_);
+  return row_passes_;
 }
 
 std::vector<GemmShape> GemmLog::shapes() const {
@@ -78,21 +96,31 @@ struct Operands {
 
 }  // namespace
 
-double time_gemm_shapes(const std::vector<GemmShape>& shapes, double min_seconds, bool share_out) {
+double time_gemm_shapes(const std::vector<GemmShape>& shapes, double min_seconds, bool share_out,
+                        std::vector<double>* each) {
+  if (each != nullptr) each->assign(shapes.size(), 0.0);
   if (shapes.empty()) return 0.0;
+  using Clock = std::chrono::steady_clock;
   const int threads = share_out ? Eigen::nbThreads() : 1;
   std::vector<Operands> operands;
   for (int t = 0; t < threads; ++t) operands.emplace_back(shapes);
+  // Each product's seconds go to its own slot (no two threads share one).
+  std::vector<double> sums(shapes.size(), 0.0);
+  auto run = [&](int i, int thread) {
+    const Clock::time_point start = Clock::now();
+    operands[thread].run(shapes[i]);
+    sums[i] += std::chrono::duration<double>(Clock::now() - start).count();
+  };
   auto pass = [&] {
     if (!share_out) {
-      for (const GemmShape& s : shapes) operands[0].run(s);
+      for (int i = 0; i < static_cast<int>(shapes.size()); ++i) run(i, 0);
       return;
     }
     detail::parallel_for(static_cast<int>(shapes.size()), threads, detail::Schedule::kOneAtATime,
-                         [&](int i, int thread) { operands[thread].run(shapes[i]); });
+                         run);
   };
   pass();  // kernels compiled, pages touched
-  using Clock = std::chrono::steady_clock;
+  std::fill(sums.begin(), sums.end(), 0.0);
   const Clock::time_point start = Clock::now();
   int passes = 0;
   double seconds = 0.0;
@@ -101,6 +129,9 @@ double time_gemm_shapes(const std::vector<GemmShape>& shapes, double min_seconds
     ++passes;
     seconds = std::chrono::duration<double>(Clock::now() - start).count();
   } while (seconds < min_seconds);
+  if (each != nullptr) {
+    for (size_t i = 0; i < sums.size(); ++i) (*each)[i] = sums[i] / passes;
+  }
   return seconds / passes;
 }
 
