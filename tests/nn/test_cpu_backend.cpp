@@ -27,8 +27,8 @@ struct Batch {
   Normalizers normalizers;
   RowMatrixXf weights;  // the loss is Σ weights·output
 
-  Batch() {
-    lattices = testing::movi_a_lattices(8, [](int) { return 6; });
+  explicit Batch(int scenes = 8) {
+    lattices = testing::movi_a_lattices(scenes, [](int) { return 6; });
     GraphBuilder(network.config().graph).build(testing::scenes_of(lattices), graph);
     network.layout().initialize(params, 5);
     normalizers = network.make_normalizers();
@@ -108,7 +108,7 @@ TEST(CpuBackend, ResultsDoNotDependOnTheThreadCount) {
       r.grads.assign(batch.params.size(), 0.0f);
       r.loss = backend->forward_backward(batch.params.data(), batch.normalizers, batch.graph,
                                          r.grads.data(), batch.loss());
-      // forward(keep) then backward: the same chunks and lanes, the same sums.
+      // forward(keep) then backward: the same chunks, the same sums.
       backend->forward(batch.params.data(), batch.normalizers, batch.graph, true);
       r.split_grads.assign(batch.params.size(), 0.0f);
       backend->backward(batch.params.data(), r.split_grads.data(), batch.graph, batch.weights);
@@ -122,6 +122,26 @@ TEST(CpuBackend, ResultsDoNotDependOnTheThreadCount) {
     EXPECT_EQ(other->loss, one.loss);
   }
   EXPECT_EQ(one.split_grads, one.grads);
+}
+
+// A batch of over 16 chunks' worth (~9,000 mesh nodes) runs in 16 larger chunks, each with its
+// gradient buffer: still the whole graph's results, and the same for any thread count.
+TEST(CpuBackend, LargeBatchesToo) {
+  const Batch batch(24);
+  ASSERT_GT(batch.graph.num_mesh_nodes(), 16 * 500);
+  const auto [whole_output, whole_grads] = batch.run_whole();
+  auto run = [&](int threads) {
+    return with_threads(threads, [&] {
+      auto backend = make_cpu_backend(batch.network);
+      std::vector<float> grads(batch.params.size(), 0.0f);
+      backend->forward_backward(batch.params.data(), batch.normalizers, batch.graph, grads.data(),
+                                batch.loss());
+      return grads;
+    });
+  };
+  const std::vector<float> one = run(1);
+  EXPECT_LT(max_difference(one, whole_grads), 1e-4 * max_abs(whole_grads));
+  EXPECT_EQ(run(2), one);
 }
 
 // One graph run whole (a single scene, a small batch) threads its products instead: the same
