@@ -140,7 +140,9 @@ TEST(CpuBackend, LargeBatchesToo) {
     });
   };
   const std::vector<float> one = run(1);
-  EXPECT_LT(max_difference(one, whole_grads), 1e-4 * max_abs(whole_grads));
+  // Sums over three times the rows of the batch above round further apart (1.1e-4 of the largest
+  // gradient on oneDNN's avx2 kernels); a scene left out or counted twice moves them by percents.
+  EXPECT_LT(max_difference(one, whole_grads), 1e-3 * max_abs(whole_grads));
   EXPECT_EQ(run(2), one);
 }
 
