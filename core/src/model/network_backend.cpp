@@ -30,7 +30,8 @@ namespace {
 // parameter gradients go into a buffer of its own, added up in chunk order: the sum does not
 // depend on the thread count nor on which thread ran which chunk, so idle threads take the next
 // chunk, largest first (a scene's cost varies several-fold with its contacts, and fixed shares
-// left one of two threads idle for a seventh of a step). One scene, or a small graph, runs whole.
+// left one of two threads idle for a seventh of their time). One scene, or a small graph, runs
+// whole.
 class CpuBackend final : public NetworkBackend {
  public:
   // About one MOVi-A scene: with fewer rows per chunk its matrices stay in cache, and the
