@@ -82,6 +82,8 @@ class CpuBackend final : public NetworkBackend {
       return NetworkBackend::forward_backward(params, normalizers, graph, grads, loss);
     }
     chunk_loss_.assign(chunk_count(), 0.0);
+    const size_t threads = static_cast<size_t>(team_size(chunk_count()));
+    if (thread_d_output_.size() < threads) thread_d_output_.resize(threads);
     // A thread's chunks run one after another in the thread's workspace.
     sum_over_chunks(grads, [&](int c, int thread, float* chunk_grads) {
       const Graph& chunk = chunk_graphs_[c];
@@ -141,8 +143,6 @@ class CpuBackend final : public NetworkBackend {
     const int chunks = chunk_count();
     const size_t count = network_.layout().size();
     if (static_cast<int>(chunk_grads_.size()) < chunks) chunk_grads_.resize(chunks);
-    const int threads = std::max(1, std::min(Eigen::nbThreads(), chunks));
-    if (static_cast<int>(thread_d_output_.size()) < threads) thread_d_output_.resize(threads);
     run_parallel(chunks, [&](int i, int thread) {
       const int c = largest_first_[i];
       std::vector<float>& sum = chunk_grads_[c];
@@ -163,11 +163,14 @@ class CpuBackend final : public NetworkBackend {
     return workspaces_[index];
   }
 
+  // The threads that run_parallel(n, ...) uses.
+  static int team_size(int n) { return std::max(1, std::min(Eigen::nbThreads(), n)); }
+
   // f(0..n-1) on up to Eigen::nbThreads() threads, the next index to the next idle one; the
   // products inside run single-threaded.
   template <class F>
   void run_parallel(int n, F&& f) {
-    const int threads = std::max(1, std::min(Eigen::nbThreads(), n));
+    const int threads = team_size(n);
     workspace(std::max(n, threads) - 1);  // before the threads: resizing moves workspaces
     detail::parallel_for(n, threads, detail::Schedule::kOneAtATime, f);
   }
