@@ -2,7 +2,8 @@
 """The validations of `fignet train` logs (OUT.log.jsonl) as one Markdown table.
 
 Usage: scripts/training-log.py [--batch NAME=B ...] [--cost NAME=C ...] [--against NAME] [--fit]
-                               [--fit-from SAMPLES] [--plot PNG] LOG [LOG ...]
+                               [--fit-from SAMPLES] [--plot PNG] [--side-by-side]
+                               LOG [LOG ...]
 
 One row per validation of each log: steps, samples seen (the log's "samples"; logs from before
 that field need --batch, and count steps × batch), the rollouts' mean translation and rotation error,
@@ -30,6 +31,14 @@ scatter by 10-30 %, so the fit says how the curve trends, not what a longer run 
 Logs of runs with --valid-stress get a second table: per validation and stress case, the drift of
 bodies started at rest (or the error against Bullet) and the late speed, for the network alone
 and for the world as users get it.
+
+--side-by-side prints instead one short table with the runs side by side, one row per sample
+count at which every run validated: the validation translation error (the lowest in bold; with
+--against, each other run's per cent from NAME's), and, from runs with --valid-stress, what rest
+does with the network alone: the MOVi cube's lowest point (cm, < 0 is into the floor), the drift
+of the stacks of 3 and 5 cubes and of 3 MOVi cubes (cm), and the 10-object pile's drift (m).
+Each cell lists the runs' figures in the order the logs were given ("—" where a run's log lacks
+the figure).
 """
 import argparse
 import json
@@ -119,6 +128,57 @@ def stress_cell(figures) -> str:
     return f"error {figures['error_m']:.3f} m{late}"
 
 
+# The rest figures of --side-by-side: column heading, stress case, figure of the network alone,
+# and the factor and format it is printed with.
+REST_COLUMNS = [
+    ("MOVi cube at rest, lowest point (cm)", [("MOVi cube at rest", "lowest_m")], 100, "{:+.1f}"),
+    ("stacks of 3 / 5 cubes, 3 MOVi cubes: drift (cm)",
+     [("stack of 3 cubes", "drift_m"), ("stack of 5 cubes", "drift_m"),
+      ("stack of 3 MOVi cubes", "drift_m")], 100, "{:.1f}"),
+    ("10-object pile: drift (m)", [("10-object pile at rest", "drift_m")], 1, "{:.2f}"),
+]
+
+
+def side_by_side(runs, stress_runs, reference_name):
+    """--side-by-side: the runs' validations and rest figures at each sample count all share."""
+    names = [name for name, _ in runs]
+    by_samples = [{v["samples"]: v for v in validations if v["samples"] is not None}
+                  for _, validations in runs]
+    stress_by_samples = [{e.get("samples"): e["stress"] for e in entries}
+                         for _, entries in stress_runs]
+    shared = sorted(set.intersection(*(set(table) for table in by_samples)))
+    with_rest = any(table for table in stress_by_samples)
+    columns = ["samples", f"validation translation (m): {' / '.join(names)}"]
+    if reference_name is not None:
+        columns.append(f"against {reference_name}")
+    if with_rest:
+        columns += [heading for heading, _, _, _ in REST_COLUMNS]
+    print("| " + " | ".join(columns) + " |")
+    print("|" + "---|" * len(columns))
+    for samples in shared:
+        errors = [table[samples]["valid_translation_m"] for table in by_samples]
+        best = min(errors)
+        cells = [format_count(samples),
+                 " / ".join(f"**{e:.3f}**" if e == best and len(errors) > 1 else f"{e:.3f}"
+                            for e in errors)]
+        if reference_name is not None:
+            ref = errors[names.index(reference_name)]
+            cells.append(" / ".join(
+                f"{100 * (e / ref - 1):+.1f} %".replace("-", "−")
+                for name, e in zip(names, errors) if name != reference_name))
+        if with_rest:
+            for _, figures, factor, form in REST_COLUMNS:
+                per_run = []
+                for table in stress_by_samples:
+                    stress = table.get(samples, {})
+                    values = [stress.get(case, {}).get("network_alone", {}).get(key)
+                              for case, key in figures]
+                    per_run.append(", ".join(form.format(factor * v) if v is not None else "—"
+                                             for v in values))
+                cells.append(" / ".join(per_run))
+        print("| " + " | ".join(cells) + " |")
+
+
 def format_count(value: float) -> str:
     return f"{value / 1e6:.2f}M" if value >= 1e6 else f"{value / 1e3:.0f}k"
 
@@ -139,6 +199,9 @@ def main() -> int:
                         help="fit only the validations from this many samples on (e.g. 100k)")
     parser.add_argument("--plot", type=pathlib.Path, metavar="PNG",
                         help="write the curves (and fits) on log-log axes to this PNG")
+    parser.add_argument("--side-by-side", action="store_true",
+                        help="one short table: the runs' validation and rest figures side by "
+                             "side at the samples where all validated")
     args = parser.parse_args()
     given = {}
     for item in args.batch:
@@ -174,6 +237,7 @@ def main() -> int:
             return 1
 
     reference = None
+    reference_name = None
     if args.against is not None:
         names = [name for name, _ in runs]
         matches = [args.against] if args.against in names else [
@@ -201,6 +265,10 @@ def main() -> int:
             else:
                 cells.append("-")
         return " / ".join(cells)
+
+    if args.side_by_side:
+        side_by_side(runs, stress_runs, reference_name)
+        return 0
 
     with_compute = bool(costs)
     compute_header = " compute |" if with_compute else ""

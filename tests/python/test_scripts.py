@@ -255,3 +255,40 @@ def test_rest_response_perturbation_moves_a_falling_cube_in_proportion(source_di
                           str(source_dir / "models" / "movi-a-small.h5"), "--perturb", "-1"],
                          capture_output=True, text=True)
     assert bad.returncode != 0 and "--perturb must be > 0" in bad.stderr
+
+
+def test_side_by_side_puts_runs_next_to_each_other_at_shared_samples(source_dir, tmp_path):
+    # Two runs validated at 10k and 20k, one also at 30k: only the shared rows, the lower error in
+    # bold, the per cent from the reference, and each rest figure of the network alone in the
+    # logs' order, scaled to its unit; a case one log lacks is "—".
+    def stress(lowest, stack, pile):
+        alone = {"finite": True, "late_speed_m_s": 0.0, "drift_deg": 0.1}
+        cases = {"MOVi cube at rest": {"network_alone": {**alone, "drift_m": 0.01,
+                                                          "lowest_m": lowest}},
+                 "stack of 3 cubes": {"network_alone": {**alone, "drift_m": stack}},
+                 "stack of 5 cubes": {"network_alone": {**alone, "drift_m": 2 * stack}}}
+        if pile is not None:
+            cases["10-object pile at rest"] = {"network_alone": {**alone, "drift_m": pile}}
+        return cases
+
+    runs = {"base": [(10_000, 2.0, -0.05, 0.04, 1.5), (20_000, 1.0, 0.002, 0.03, 0.2)],
+            "lever": [(10_000, 1.5, 0.001, 0.02, None), (20_000, 1.1, 0.003, 0.01, None),
+                      (30_000, 0.9, 0.004, 0.01, None)]}
+    for name, points in runs.items():
+        with open(tmp_path / f"{name}.h5.log.jsonl", "w") as log:
+            for samples, translation, lowest, stack, pile in points:
+                log.write(json.dumps({"step": samples // 8, "samples": samples,
+                                      "valid_translation_m": translation,
+                                      "valid_rotation_deg": 40.0}) + "\n")
+                log.write(json.dumps({"step": samples // 8, "samples": samples,
+                                      "stress": stress(lowest, stack, pile)}) + "\n")
+    result = run_training_log(source_dir, "--side-by-side", "--against", "base",
+                              *(str(tmp_path / f"{n}.h5.log.jsonl") for n in ("base", "lever")))
+    assert result.returncode == 0, result.stderr
+    assert "base / lever" in result.stdout.splitlines()[0]
+    rows = table_rows(result.stdout)
+    assert [row[0] for row in rows] == ["10k", "20k"], result.stdout
+    assert rows[0][1:] == ["2.000 / **1.500**", "−25.0 %", "-5.0 / +0.1",
+                           "4.0, 8.0, — / 2.0, 4.0, —", "1.50 / —"]
+    assert rows[1][1:3] == ["**1.000** / 1.100", "+10.0 %"]
+    assert rows[1][3] == "+0.2 / +0.3"
