@@ -173,8 +173,9 @@ def side_by_side(runs, stress_runs, reference_name):
                     stress = table.get(samples, {})
                     values = [stress.get(case, {}).get("network_alone", {}).get(key)
                               for case, key in figures]
-                    per_run.append(", ".join(form.format(factor * v) if v is not None else "—"
-                                             for v in values))
+                    per_run.append(", ".join(
+                        form.format(factor * v).replace("-", "−") if v is not None else "—"
+                        for v in values))
                 cells.append(" / ".join(per_run))
         print("| " + " | ".join(cells) + " |")
 

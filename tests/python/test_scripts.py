@@ -288,7 +288,7 @@ def test_side_by_side_puts_runs_next_to_each_other_at_shared_samples(source_dir,
     assert "base / lever" in result.stdout.splitlines()[0]
     rows = table_rows(result.stdout)
     assert [row[0] for row in rows] == ["10k", "20k"], result.stdout
-    assert rows[0][1:] == ["2.000 / **1.500**", "−25.0 %", "-5.0 / +0.1",
+    assert rows[0][1:] == ["2.000 / **1.500**", "−25.0 %", "−5.0 / +0.1",
                            "4.0, 8.0, — / 2.0, 4.0, —", "1.50 / —"]
     assert rows[1][1:3] == ["**1.000** / 1.100", "+10.0 %"]
     assert rows[1][3] == "+0.2 / +0.3"
