@@ -3,8 +3,10 @@
 // the network through either product engine gives the same results to float tolerance.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include "../movi_lattices.h"
@@ -144,6 +146,36 @@ TEST(CpuBackend, LargeBatchesToo) {
   // gradient on oneDNN's avx2 kernels); a scene left out or counted twice moves them by percents.
   EXPECT_LT(max_difference(one, whole_grads), 1e-3 * max_abs(whole_grads));
   EXPECT_EQ(run(2), one);
+}
+
+// The chunks' gradient buffers are reused from call to call (zeroed as they are summed): a second
+// call gives the first's bits, and so does a call after one whose loss threw midway through the
+// chunks (its buffers left half filled).
+TEST(CpuBackend, RepeatedCallsAndACallAfterAFailureGiveTheSameBits) {
+  const Batch batch;
+  auto backend = make_cpu_backend(batch.network);
+  auto step = [&](const LossGradient& loss) {
+    std::vector<float> grads(batch.params.size(), 0.0f);
+    backend->forward_backward(batch.params.data(), batch.normalizers, batch.graph, grads.data(),
+                              loss);
+    return grads;
+  };
+  const std::vector<float> first = step(batch.loss());
+  EXPECT_EQ(step(batch.loss()), first);
+  for (int threads : {1, 2}) {
+    with_threads(threads, [&] {
+      std::atomic<int> calls = 0;  // the chunks' threads call the loss
+      const LossGradient fails_on_the_third = [&](int first_node, const ConstMatrixRef& output,
+                                                  MatrixRef d_output) {
+        if (++calls == 3) throw std::runtime_error("loss failed");
+        return batch.loss()(first_node, output, d_output);
+      };
+      EXPECT_THROW(step(fails_on_the_third), std::runtime_error);
+      EXPECT_GE(calls, 3);
+      EXPECT_EQ(step(batch.loss()), first) << threads << " thread(s)";
+      return 0;
+    });
+  }
 }
 
 // One graph run whole (a single scene, a small batch) threads its products instead: the same
