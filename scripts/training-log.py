@@ -163,9 +163,8 @@ def side_by_side(runs, stress_runs, reference_name):
                             for e in errors)]
         if reference_name is not None:
             ref = errors[names.index(reference_name)]
-            cells.append(" / ".join(
-                f"{100 * (e / ref - 1):+.1f} %".replace("-", "−")
-                for name, e in zip(names, errors) if name != reference_name))
+            cells.append(" / ".join(percent_from(e, ref)
+                                    for name, e in zip(names, errors) if name != reference_name))
         if with_rest:
             for _, figures, factor, form in REST_COLUMNS:
                 per_run = []
@@ -174,10 +173,20 @@ def side_by_side(runs, stress_runs, reference_name):
                     values = [stress.get(case, {}).get("network_alone", {}).get(key)
                               for case, key in figures]
                     per_run.append(", ".join(
-                        form.format(factor * v).replace("-", "−") if v is not None else "—"
+                        with_minus(form.format(factor * v)) if v is not None else "—"
                         for v in values))
                 cells.append(" / ".join(per_run))
         print("| " + " | ".join(cells) + " |")
+
+
+def with_minus(text: str) -> str:
+    """A figure with the minus sign (−) of the tables instead of a hyphen."""
+    return text.replace("-", "−")
+
+
+def percent_from(value: float, reference: float) -> str:
+    """How far value is from reference, in per cent: "−12.0 %" is 12 % below it."""
+    return with_minus(f"{100 * (value / reference - 1):+.1f} %")
 
 
 def format_count(value: float) -> str:
@@ -262,7 +271,7 @@ def main() -> int:
         cells = []
         for key in ("valid_translation_m", "valid_one_step_m_moving_contact"):
             if key in entry and key in other and other[key] > 0:
-                cells.append(f"{100 * (entry[key] / other[key] - 1):+.1f} %".replace("-", "−"))
+                cells.append(percent_from(entry[key], other[key]))
             else:
                 cells.append("-")
         return " / ".join(cells)

@@ -143,20 +143,21 @@ class CpuBackend final : public NetworkBackend {
     const int chunks = chunk_count();
     const size_t count = network_.layout().size();
     if (static_cast<int>(chunk_grads_.size()) < chunks) chunk_grads_.resize(chunks);
-    // The buffers are zero here: new ones are made so, and the sum below leaves them so. Only a
-    // call that stopped between the two (an exception in f) zeroes them again.
-    if (!chunk_grads_zero_) {
-      for (std::vector<float>& sum : chunk_grads_) sum.assign(sum.size(), 0.0f);
+    // The buffers are zero here: new ones are made so, and the sum below leaves them so.
+    try {
+      run_parallel(chunks, [&](int i, int thread) {
+        const int c = largest_first_[i];
+        std::vector<float>& sum = chunk_grads_[c];
+        if (sum.size() != count) sum.assign(count, 0.0f);
+        f(c, thread, sum.data());
+      });
+    } catch (...) {
+      // A chunk that threw leaves the others' buffers filled and never summed.
+      for (std::vector<float>& sum : chunk_grads_) std::fill(sum.begin(), sum.end(), 0.0f);
+      throw;
     }
-    chunk_grads_zero_ = false;
-    run_parallel(chunks, [&](int i, int thread) {
-      const int c = largest_first_[i];
-      std::vector<float>& sum = chunk_grads_[c];
-      if (sum.size() != count) sum.assign(count, 0.0f);
-      f(c, thread, sum.data());
-    });
     // Each block of a buffer is zeroed for the next call just after it is added, while in cache:
-    // a separate pass over every buffer cost as much again as the sum (a few MB per chunk).
+    // a separate pass over every buffer cost about as much as the sum itself.
     detail::parallel_for_blocks(count, kSumBlock, Eigen::nbThreads(),
                                 [&](size_t begin, size_t end) {
                                   for (int c = 0; c < chunks; ++c) {
@@ -165,7 +166,6 @@ class CpuBackend final : public NetworkBackend {
                                     std::fill(sum + begin, sum + end, 0.0f);
                                   }
                                 });
-    chunk_grads_zero_ = true;
   }
 
   NetworkWorkspace& workspace(int index) {
@@ -193,7 +193,6 @@ class CpuBackend final : public NetworkBackend {
   std::vector<int> largest_first_;
   std::vector<NetworkWorkspace> workspaces_;
   std::vector<std::vector<float>> chunk_grads_;
-  bool chunk_grads_zero_ = true;
   std::vector<Buffer> thread_d_output_;
   std::vector<double> chunk_loss_;
   Buffer output_;
