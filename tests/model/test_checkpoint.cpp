@@ -47,6 +47,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   trainer_config.adam.decay_steps = 20;
   trainer_config.adam.decay_start_step = 3;  // the resumed run's rate must decay from step 3
   trainer_config.rest_loss_weight = 30.0f;
+  trainer_config.impact_loss_weight = 4.0f;
   trainer_config.still_air_fraction = 0.5f;
   trainer_config.pushforward_fraction = 0.5f;
   trainer_config.pushforward_skips_rest = true;
@@ -64,6 +65,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   EXPECT_EQ(checkpoint.trainer_config.adam.decay_steps, 20);
   EXPECT_EQ(checkpoint.trainer_config.adam.decay_start_step, 3);
   EXPECT_EQ(checkpoint.trainer_config.rest_loss_weight, 30.0f);
+  EXPECT_EQ(checkpoint.trainer_config.impact_loss_weight, 4.0f);
   EXPECT_EQ(checkpoint.trainer_config.still_air_fraction, 0.5f);
   EXPECT_EQ(checkpoint.trainer_config.pushforward_fraction, 0.5f);
   EXPECT_TRUE(checkpoint.trainer_config.pushforward_skips_rest);
@@ -88,6 +90,7 @@ TEST_F(Checkpoints, AFileWithoutLaterFieldsReadsWhatOlderRunsTrainedWith) {
   trainer_config.huber_delta = 2.0f;
   trainer_config.statistics_warmup = 3;
   trainer_config.rest_loss_weight = 30.0f;
+  trainer_config.impact_loss_weight = 4.0f;
   trainer_config.still_air_fraction = 0.5f;
   trainer_config.weight_average = 0.75f;
   trainer_config.pushforward_fraction = 0.5f;
@@ -101,9 +104,9 @@ TEST_F(Checkpoints, AFileWithoutLaterFieldsReadsWhatOlderRunsTrainedWith) {
     H5::H5File file(path.string(), H5F_ACC_RDWR);
     H5::Group training = file.openGroup("training");
     for (const char* name :
-         {"gradient_clip", "huber_delta", "statistics_warmup", "rest_loss_weight", "weight_average",
-          "still_air_fraction", "pushforward_fraction", "pushforward_skips_rest",
-          "pushforward_steps", "planned_steps"}) {
+         {"gradient_clip", "huber_delta", "statistics_warmup", "rest_loss_weight",
+          "impact_loss_weight", "weight_average", "still_air_fraction", "pushforward_fraction",
+          "pushforward_skips_rest", "pushforward_steps", "planned_steps"}) {
       training.removeAttr(name);
     }
   }
@@ -113,6 +116,7 @@ TEST_F(Checkpoints, AFileWithoutLaterFieldsReadsWhatOlderRunsTrainedWith) {
   EXPECT_EQ(checkpoint.trainer_config.huber_delta, defaults.huber_delta);
   EXPECT_EQ(checkpoint.trainer_config.statistics_warmup, defaults.statistics_warmup);
   EXPECT_EQ(checkpoint.trainer_config.rest_loss_weight, defaults.rest_loss_weight);
+  EXPECT_EQ(checkpoint.trainer_config.impact_loss_weight, defaults.impact_loss_weight);
   EXPECT_EQ(checkpoint.trainer_config.weight_average, defaults.weight_average);
   EXPECT_EQ(checkpoint.trainer_config.still_air_fraction, defaults.still_air_fraction);
   EXPECT_EQ(checkpoint.trainer_config.pushforward_fraction, defaults.pushforward_fraction);

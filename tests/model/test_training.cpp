@@ -280,6 +280,61 @@ TEST(Trainer, RestLossWeightScalesOnlyTheRestingBodiesShare) {
   EXPECT_NEAR(weighted - both, 4.0 * (both - flying), 1e-6 * weighted);
 }
 
+// A falling cube kicked between frames 3 and 4 (an acceleration of 115 m/s² beyond gravity into
+// frame 4) and a resting cube: only the first at frame 3 is an impact; free fall, rest and
+// kinematic bodies never are.
+std::vector<Trajectory> kicked_and_resting_cubes(int frames) {
+  auto data = flying_and_resting_cubes(frames);
+  for (int k = 4; k < frames; ++k) data[0].objects[0].poses[k].position.x() += 0.05 * (k - 3);
+  return data;
+}
+
+TEST(TrainingBatch, MarksImpactsWhereTheCentreDepartsFromGravity) {
+  auto data = kicked_and_resting_cubes(8);
+  const double still = kRestSpeed * data[0].time_step;
+  auto motion_at = [&](int frame) {
+    std::vector<std::uint8_t> motion = resting_objects(data[0], frame, still);
+    mark_impacts(data[0], frame, kImpactG, motion);
+    return motion;
+  };
+  EXPECT_EQ(motion_at(2), (std::vector<std::uint8_t>{kMoving, kResting}));
+  EXPECT_EQ(motion_at(3), (std::vector<std::uint8_t>{kImpact, kResting}));
+  EXPECT_EQ(motion_at(4), (std::vector<std::uint8_t>{kMoving, kResting}));
+  // The threshold: the kick is 0.05 m / dt² = 115 m/s², between 11 g and 12 g here.
+  std::vector<std::uint8_t> motion = resting_objects(data[0], 3, still);
+  mark_impacts(data[0], 3, 12.0, motion);
+  EXPECT_EQ(motion[0], kMoving);
+  mark_impacts(data[0], 3, 11.0, motion);
+  EXPECT_EQ(motion[0], kImpact);
+  data[0].objects[0].kinematic = true;
+  EXPECT_EQ(motion_at(3), (std::vector<std::uint8_t>{kMoving, kResting}));
+  std::vector<std::uint8_t> short_flags(1, kMoving);
+  EXPECT_THROW(mark_impacts(data[0], 3, kImpactG, short_flags), ConfigError);
+}
+
+// The impact weight multiplies the kicked cube's share of the loss at its impact and nothing
+// else: the loss over every sample is affine in the weight, and the rest weight's share stays.
+TEST(Trainer, ImpactLossWeightScalesOnlyTheImpactsShare) {
+  const auto data = kicked_and_resting_cubes(10);
+  auto loss_with = [&](float weight) {
+    TrainerConfig trainer_config;
+    trainer_config.rest_loss_weight = 3.0f;
+    trainer_config.impact_loss_weight = weight;
+    return untrained_loss(trainer_config, data);
+  };
+  const double without = loss_with(0.0f), plain = loss_with(1.0f), weighted = loss_with(5.0f);
+  ASSERT_GT(without, 0.0);
+  ASSERT_GT(plain, without);  // the untrained network does not predict the kick
+  EXPECT_NEAR(weighted - plain, 4.0 * (plain - without), 1e-6 * weighted);
+  // Weight 1 is a run without the field.
+  TrainerConfig rest_only;
+  rest_only.rest_loss_weight = 3.0f;
+  EXPECT_DOUBLE_EQ(untrained_loss(rest_only, data), plain);
+  TrainerConfig bad;
+  bad.impact_loss_weight = std::nanf("");
+  EXPECT_THROW(Trainer(small_model(), bad, data), ConfigError);
+}
+
 // Both cubes of a frame held still and let go: lifted together until the lower one's lowest
 // vertex is `gap` above the floor, their histories still (no noise) or a walk that the target
 // undoes (noise, correction 1), and every target row is gravity·dt².

@@ -115,6 +115,12 @@ TEST(TrainingConfig, BadInputNamesTheField) {
   config.apply_setting("pushforward_steps=9");
   EXPECT_NE(error_of([&] { config.validate(); }).find("pushforward_steps = 9 (must be in 1..8"),
             std::string::npos);
+  config.apply_setting("pushforward_steps=1");
+  config.apply_setting("impact_loss_weight=-2");
+  EXPECT_NE(error_of([&] { config.validate(); }).find("impact_loss_weight = -2 (must be >= 0"),
+            std::string::npos);
+  config.apply_setting("impact_loss_weight=4");
+  EXPECT_NO_THROW(config.validate());
 }
 
 TEST(DataRange, WidensToHoldEachValueAndHoldsEverythingWhileUnknown) {

@@ -24,6 +24,7 @@ void write_training(H5::Group group, const TrainerConfig& config, const TrainerS
   write_attribute(group, "huber_delta", double{config.huber_delta});
   write_attribute(group, "statistics_warmup", static_cast<long long>(config.statistics_warmup));
   write_attribute(group, "rest_loss_weight", double{config.rest_loss_weight});
+  write_attribute(group, "impact_loss_weight", double{config.impact_loss_weight});
   write_attribute(group, "weight_average", double{config.weight_average});
   write_attribute(group, "still_air_fraction", double{config.still_air_fraction});
   write_attribute(group, "pushforward_fraction", double{config.pushforward_fraction});
@@ -59,6 +60,7 @@ void read_training(const H5::Group& group, size_t parameters, const std::string&
   config.statistics_warmup =
       static_cast<int>(read_integer_or(group, "statistics_warmup", config.statistics_warmup));
   config.rest_loss_weight = read_float_or("rest_loss_weight", config.rest_loss_weight);
+  config.impact_loss_weight = read_float_or("impact_loss_weight", config.impact_loss_weight);
   config.weight_average = read_float_or("weight_average", config.weight_average);
   config.still_air_fraction = read_float_or("still_air_fraction", config.still_air_fraction);
   config.pushforward_fraction = read_float_or("pushforward_fraction", config.pushforward_fraction);

@@ -77,6 +77,11 @@ Trainer::Trainer(const ModelConfig& config, const TrainerConfig& trainer_config,
   }
   // The average starts at the starting parameters (restore() replaces it with a checkpoint's).
   if (trainer_config.weight_average > 0.0f) averaged_params_ = params_;
+  if (!(trainer_config.impact_loss_weight >= 0.0f) ||
+      !std::isfinite(trainer_config.impact_loss_weight)) {
+    throw ConfigError(fmt::format("trainer: impact_loss_weight = {} (must be >= 0; 1: off)",
+                                  trainer_config.impact_loss_weight));
+  }
   if (!(trainer_config.still_air_fraction >= 0.0f && trainer_config.still_air_fraction <= 1.0f)) {
     throw ConfigError(fmt::format("trainer: still_air_fraction = {} (must be in [0, 1]; 0: none)",
                                   trainer_config.still_air_fraction));
@@ -210,6 +215,9 @@ void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64
         } else {
           batch.scene_resting[b] =
               resting_objects(trajectory, samples[b].frame, kRestSpeed * trajectory.time_step);
+          if (trainer_config_.impact_loss_weight != 1.0f) {
+            mark_impacts(trajectory, samples[b].frame, kImpactG, batch.scene_resting[b]);
+          }
         }
       }
     }
@@ -276,9 +284,10 @@ void Trainer::build_graph(int threads, PreparedBatch& batch,
   }
   gather_targets(batch.graph, omit ? batch.kept_targets : batch.scene_targets, batch.targets,
                  batch.in_loss);
-  if (weighs_rest()) {
+  if (weighs_bodies()) {
     gather_loss_weights(batch.graph, omit ? batch.kept_resting : batch.scene_resting,
-                        trainer_config_.rest_loss_weight, batch.loss_weights);
+                        trainer_config_.rest_loss_weight, trainer_config_.impact_loss_weight,
+                        batch.loss_weights);
   }
 }
 
@@ -336,7 +345,7 @@ void Trainer::push_forward_current() {
         if (trainer_config_.pushforward_skips_rest) {
           const TrajectoryObject* truth = data_[sample.trajectory].objects.data();
           for (size_t o = 0; o < next.size(); ++o) {
-            if (batch.scene_resting[b][o]) next[o] = truth[o].poses[frame];
+            if (batch.scene_resting[b][o] == kResting) next[o] = truth[o].poses[frame];
           }
         }
         advance_to_predicted(data_[sample.trajectory], frame, h, next, correction, scene,
@@ -470,7 +479,7 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
   };
   const float scale = 2.0f / static_cast<float>(3 * count);
   // The loss of the output rows of nodes [first, first + rows), and its gradient when asked.
-  const bool weighted = weighs_rest();
+  const bool weighted = weighs_bodies();
   auto node_loss = [&](int first, const ConstMatrixRef& output, MatrixRef* d_output) {
     double squares = 0.0;
     if (d_output) d_output->setZero();

@@ -199,9 +199,29 @@ std::vector<std::uint8_t> resting_objects(const Trajectory& trajectory, int fram
     const Points after = posed_vertices(*object.mesh, object.poses[frame + 1]);
     const double moved = std::max((now - before).rowwise().norm().maxCoeff(),
                                   (after - now).rowwise().norm().maxCoeff());
-    resting[o] = moved < max_step ? 1 : 0;
+    resting[o] = moved < max_step ? kResting : kMoving;
   }
   return resting;
+}
+
+void mark_impacts(const Trajectory& trajectory, int frame, double impact_g,
+                  std::vector<std::uint8_t>& motion) {
+  if (motion.size() != trajectory.objects.size()) {
+    throw ConfigError(fmt::format("mark_impacts: {} flags for {} objects", motion.size(),
+                                  trajectory.objects.size()));
+  }
+  if (frame < 1 || frame + 1 >= trajectory.num_frames()) return;
+  const double dt = trajectory.time_step;
+  const double threshold = impact_g * trajectory.gravity.norm();
+  for (size_t o = 0; o < trajectory.objects.size(); ++o) {
+    const TrajectoryObject& object = trajectory.objects[o];
+    if (object.kinematic || motion[o] != kMoving) continue;
+    const Vec3 acceleration =
+        (object.poses[frame + 1].position - 2.0 * object.poses[frame].position +
+         object.poses[frame - 1].position) /
+        (dt * dt);
+    if ((acceleration - trajectory.gravity).norm() > threshold) motion[o] = kImpact;
+  }
 }
 
 void gather_targets(const Graph& graph, const std::vector<Points>& scene_targets,
@@ -219,15 +239,17 @@ void gather_targets(const Graph& graph, const std::vector<Points>& scene_targets
 }
 
 void gather_loss_weights(const Graph& graph,
-                         const std::vector<std::vector<std::uint8_t>>& scene_resting,
-                         float rest_weight, std::vector<float>& weights) {
+                         const std::vector<std::vector<std::uint8_t>>& scene_motion,
+                         float rest_weight, float impact_weight, std::vector<float>& weights) {
   weights.assign(graph.num_mesh_nodes(), 0.0f);
   for (int s = 0; s < graph.num_scenes(); ++s) {
     const int first_object = graph.scene_first_object[s];
-    const std::vector<std::uint8_t>& resting = scene_resting[s];
-    for (size_t o = 0; o < resting.size(); ++o) {
+    const std::vector<std::uint8_t>& motion = scene_motion[s];
+    for (size_t o = 0; o < motion.size(); ++o) {
       const int object = first_object + static_cast<int>(o);
-      const float weight = resting[o] ? rest_weight : 1.0f;
+      const float weight = motion[o] == kResting  ? rest_weight
+                           : motion[o] == kImpact ? impact_weight
+                                                  : 1.0f;
       for (int i = graph.object_first_node[object]; i < graph.object_first_node[object + 1]; ++i) {
         weights[i] = graph.node_kinematic[i] ? 0.0f : weight;
       }

@@ -129,6 +129,8 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.huber_delta; })},
       {"rest_loss_weight",
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.rest_loss_weight; })},
+      {"impact_loss_weight",
+       plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.impact_loss_weight; })},
       {"still_air_fraction",
        plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.still_air_fraction; })},
       {"weight_average",
@@ -328,6 +330,11 @@ void TrainingConfig::validate() const {
     throw ConfigError(
         fmt::format("rest_loss_weight = {} (must be >= 0; 1: resting bodies count like the others)",
                     trainer.rest_loss_weight));
+  }
+  if (!(trainer.impact_loss_weight >= 0.0f) || !std::isfinite(trainer.impact_loss_weight)) {
+    throw ConfigError(fmt::format(
+        "impact_loss_weight = {} (must be >= 0; 1: bodies in an impact count like the others)",
+        trainer.impact_loss_weight));
   }
   if (!(trainer.still_air_fraction >= 0.0f && trainer.still_air_fraction <= 1.0f)) {
     throw ConfigError(fmt::format(

@@ -45,6 +45,11 @@ struct TrainerConfig {
   // Their targets are ~1e-3σ, so a bias that integrates to metres over a long rest costs the
   // unweighted loss almost nothing.
   float rest_loss_weight = 1.0f;
+  // Weight in the loss of the nodes of bodies that undergo an impact in the truth at the sample's
+  // frame (impact_objects: the centre's acceleration departs from gravity by more than
+  // kImpactG·g; 1: no different from the others). An eighth of the object-steps, they carry most
+  // of the rollout error and come out too soft.
+  float impact_loss_weight = 1.0f;
   // Share of the scenes replaced by their bodies held still in the air and let go
   // (make_still_sample_in_air), the gap under them drawn log-uniformly from kStillAirGaps (0:
   // none; trajectories with kinematic objects are never replaced). Their nodes weigh
@@ -184,7 +189,8 @@ class Trainer {
     std::vector<SampleRef> samples;  // what it was built from (draw_and_build's draw, or step_on's)
     std::vector<Scene> scenes;
     std::vector<Points> scene_targets;
-    // Per-scene flags of resting bodies, only when rest_loss_weight != 1.
+    // Per scene, per object: what the body does in the truth (BodyMotion), only when a loss
+    // weight is set or the push skips resting bodies.
     std::vector<std::vector<std::uint8_t>> scene_resting;
     std::vector<std::uint64_t> scene_seeds;
     // Per scene: how many frames early it was drawn to be pushed forward before the step
@@ -207,7 +213,7 @@ class Trainer {
     Graph graph;
     RowMatrixXf targets;
     std::vector<std::uint8_t> in_loss;
-    std::vector<float> loss_weights;  // per node, only when rest_loss_weight != 1
+    std::vector<float> loss_weights;  // per node, only when weighs_bodies()
     double build_seconds = 0.0;       // what building it last took
   };
 
@@ -243,9 +249,12 @@ class Trainer {
   // Mean over every process's dynamic nodes; with `reduce`, counts and gradients are summed
   // over processes.
   double loss_and_gradient(bool with_gradient, bool reduce);
-  bool weighs_rest() const { return trainer_config_.rest_loss_weight != 1.0f; }
-  // Whose samples carry the rest flags: those weighed in the loss or kept out of the push.
-  bool flags_rest() const { return weighs_rest() || trainer_config_.pushforward_skips_rest; }
+  bool weighs_bodies() const {
+    return trainer_config_.rest_loss_weight != 1.0f || trainer_config_.impact_loss_weight != 1.0f;
+  }
+  // Whose samples carry the bodies' motion flags: those weighed in the loss or kept out of the
+  // push.
+  bool flags_rest() const { return weighs_bodies() || trainer_config_.pushforward_skips_rest; }
   // Scales grads_ to trainer_config_.gradient_clip when longer.
   void clip_gradient();
   // averaged_params_ ← d·averaged_params_ + (1 − d)·params_, d = weight_average.

@@ -70,10 +70,23 @@ void make_still_sample_in_air(const Trajectory& trajectory, int frame, int histo
 // `angle` radians about the vertical axis through the floor's centre.
 void turn_about_vertical(double angle, Scene& scene, Points& targets);
 
-// Per object of the trajectory: 1 where the body is dynamic and at rest in the truth around the
-// sample, that is every vertex moves less than `max_step` metres over frame − 1 → frame and
-// frame → frame + 1 (a body at the top of a free flight still moves g·dt/2 per step).
+// What a body does in the truth around a sample's frame, as the loss weighs it.
+enum BodyMotion : std::uint8_t { kMoving = 0, kResting = 1, kImpact = 2 };
+
+// An impact: the centre's acceleration departs from gravity by more than this many g (the
+// one-step evaluation's impacts, OneStepOptions::impact_g).
+inline constexpr double kImpactG = 2.0;
+
+// Per object of the trajectory: kResting where the body is dynamic and at rest in the truth
+// around the sample, that is every vertex moves less than `max_step` metres over frame − 1 →
+// frame and frame → frame + 1 (a body at the top of a free flight still moves g·dt/2 per step);
+// kMoving elsewhere.
 std::vector<std::uint8_t> resting_objects(const Trajectory& trajectory, int frame, double max_step);
+
+// Marks kImpact on the dynamic bodies flagged kMoving whose centre's acceleration into the next
+// frame, (x^{t+1} − 2x^t + x^{t−1}) / dt², departs from gravity by more than impact_g·|g|.
+void mark_impacts(const Trajectory& trajectory, int frame, double impact_g,
+                  std::vector<std::uint8_t>& motion);
 
 // Stacks per-scene targets into graph row order (each scene's floor nodes get zero rows) and
 // marks which rows count in the loss (dynamic nodes).
@@ -81,10 +94,11 @@ void gather_targets(const Graph& graph, const std::vector<Points>& scene_targets
                     RowMatrixXf& targets, std::vector<std::uint8_t>& in_loss);
 
 // Each node's weight in the loss, in graph row order: 0 for kinematic nodes, `rest_weight` for
-// the nodes of objects flagged in `scene_resting` (per scene, per object as resting_objects
-// gives), 1 for the other dynamic nodes.
+// the nodes of objects flagged kResting in `scene_motion` (per scene, per object as
+// resting_objects and mark_impacts give), `impact_weight` for those flagged kImpact, 1 for the
+// other dynamic nodes.
 void gather_loss_weights(const Graph& graph,
-                         const std::vector<std::vector<std::uint8_t>>& scene_resting,
-                         float rest_weight, std::vector<float>& weights);
+                         const std::vector<std::vector<std::uint8_t>>& scene_motion,
+                         float rest_weight, float impact_weight, std::vector<float>& weights);
 
 }  // namespace fignet
