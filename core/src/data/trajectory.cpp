@@ -48,4 +48,12 @@ void scene_at_frame(const Trajectory& trajectory, int t, int history, Scene& sce
   }
 }
 
+bool is_impact(const Trajectory& trajectory, size_t o, int t, double impact_g) {
+  const std::vector<Pose>& poses = trajectory.objects[o].poses;
+  const double dt = trajectory.time_step;
+  const Vec3 acceleration =
+      (poses[t + 1].position - 2.0 * poses[t].position + poses[t - 1].position) / (dt * dt);
+  return (acceleration - trajectory.gravity).norm() > impact_g * trajectory.gravity.norm();
+}
+
 }  // namespace fignet

@@ -120,13 +120,11 @@ OneStepTotals one_step_totals(AccelerationPredictor& predictor, const GraphConfi
         if (object.kinematic) continue;
         const std::vector<Pose>& poses = truth.objects[o].poses;
         const Pose &before = poses[t - 1], &now = poses[t], &after = poses[t + 1];
-        // The truth's motion over the step, and its centre's acceleration against gravity.
+        // The truth's motion over the step.
         const double speed = (after.position - now.position).norm() / dt;
         const double angular_speed = now.orientation.angularDistance(after.orientation) / dt;
-        const Vec3 acceleration =
-            (after.position - 2.0 * now.position + before.position) / (dt * dt);
         const bool edge = interacting[o] != 0;
-        const bool impact = (acceleration - truth.gravity).norm() > options.impact_g * g;
+        const bool impact = is_impact(truth, o, t, options.impact_g);
         if (impact && !edge) totals.unseen_impacts += 1;
         const Regime regime =
             !edge ? Regime::kFreeFlight

@@ -149,7 +149,7 @@ void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64
   const int scenes = static_cast<int>(samples.size());
   batch.scenes.resize(scenes);
   batch.scene_targets.resize(scenes);
-  if (flags_rest()) batch.scene_resting.resize(scenes);
+  if (flags_motion()) batch.scene_motion.resize(scenes);
   // One noise seed per scene, drawn in scene order: the noise does not depend on the threads.
   batch.scene_seeds.resize(scenes);
   for (std::uint64_t& seed : batch.scene_seeds) seed = noise();
@@ -208,15 +208,15 @@ void Trainer::build_batch(const std::vector<SampleRef>& samples, std::mt19937_64
         if (!pushed)
           turn_about_vertical(batch.scene_yaw[b], batch.scenes[b], batch.scene_targets[b]);
       }
-      if (flags_rest()) {
+      if (flags_motion()) {
         if (gap > 0.0) {
           // Every dynamic body is still, in the air.
-          batch.scene_resting[b].assign(trajectory.objects.size(), 1);
+          batch.scene_motion[b].assign(trajectory.objects.size(), kResting);
         } else {
-          batch.scene_resting[b] =
+          batch.scene_motion[b] =
               resting_objects(trajectory, samples[b].frame, kRestSpeed * trajectory.time_step);
           if (trainer_config_.impact_loss_weight != 1.0f) {
-            mark_impacts(trajectory, samples[b].frame, kImpactG, batch.scene_resting[b]);
+            mark_impacts(trajectory, samples[b].frame, kImpactG, batch.scene_motion[b]);
           }
         }
       }
@@ -238,7 +238,7 @@ void Trainer::build_graph(int threads, PreparedBatch& batch,
     batch.kept_scenes.resize(scenes);
     batch.kept_contacts.resize(scenes);
     batch.kept_targets.resize(scenes);
-    batch.kept_resting.resize(batch.scene_resting.size());
+    batch.kept_motion.resize(batch.scene_motion.size());
   }
   auto prepare_and_split = [&](int begin, int end, GraphBuilder& builder) {
     prepare_scenes(begin, end);
@@ -247,10 +247,10 @@ void Trainer::build_graph(int threads, PreparedBatch& batch,
       FreeFlightSplit& split = batch.free_flight[b];
       split.split(builder, batch.scenes[b], nullptr, batch.kept_scenes[b], batch.kept_contacts[b]);
       split.keep_rows(batch.scenes[b], batch.scene_targets[b], batch.kept_targets[b]);
-      if (batch.scene_resting.empty()) continue;
-      batch.kept_resting[b].clear();
+      if (batch.scene_motion.empty()) continue;
+      batch.kept_motion[b].clear();
       for (const int o : split.kept_objects()) {
-        batch.kept_resting[b].push_back(batch.scene_resting[b][o]);
+        batch.kept_motion[b].push_back(batch.scene_motion[b][o]);
       }
     }
   };
@@ -285,7 +285,7 @@ void Trainer::build_graph(int threads, PreparedBatch& batch,
   gather_targets(batch.graph, omit ? batch.kept_targets : batch.scene_targets, batch.targets,
                  batch.in_loss);
   if (weighs_bodies()) {
-    gather_loss_weights(batch.graph, omit ? batch.kept_resting : batch.scene_resting,
+    gather_loss_weights(batch.graph, omit ? batch.kept_motion : batch.scene_motion,
                         trainer_config_.rest_loss_weight, trainer_config_.impact_loss_weight,
                         batch.loss_weights);
   }
@@ -345,7 +345,7 @@ void Trainer::push_forward_current() {
         if (trainer_config_.pushforward_skips_rest) {
           const TrajectoryObject* truth = data_[sample.trajectory].objects.data();
           for (size_t o = 0; o < next.size(); ++o) {
-            if (batch.scene_resting[b][o] == kResting) next[o] = truth[o].poses[frame];
+            if (batch.scene_motion[b][o] == kResting) next[o] = truth[o].poses[frame];
           }
         }
         advance_to_predicted(data_[sample.trajectory], frame, h, next, correction, scene,

@@ -211,16 +211,9 @@ void mark_impacts(const Trajectory& trajectory, int frame, double impact_g,
                                   trajectory.objects.size()));
   }
   if (frame < 1 || frame + 1 >= trajectory.num_frames()) return;
-  const double dt = trajectory.time_step;
-  const double threshold = impact_g * trajectory.gravity.norm();
   for (size_t o = 0; o < trajectory.objects.size(); ++o) {
-    const TrajectoryObject& object = trajectory.objects[o];
-    if (object.kinematic || motion[o] != kMoving) continue;
-    const Vec3 acceleration =
-        (object.poses[frame + 1].position - 2.0 * object.poses[frame].position +
-         object.poses[frame - 1].position) /
-        (dt * dt);
-    if ((acceleration - trajectory.gravity).norm() > threshold) motion[o] = kImpact;
+    if (trajectory.objects[o].kinematic || motion[o] != kMoving) continue;
+    if (is_impact(trajectory, o, frame, impact_g)) motion[o] = kImpact;
   }
 }
 

@@ -17,6 +17,10 @@ namespace fignet {
 // training loss's rest weight (every vertex) both use it.
 inline constexpr double kRestSpeed = 0.05;  // m/s
 
+// An impact: the centre's acceleration departs from gravity by more than this many g (resting
+// contact departs by one g). fignet eval's impacts and the training loss's impact weight.
+inline constexpr double kImpactG = 2.0;
+
 struct TrajectoryObject {
   std::shared_ptr<const TriangleMesh> mesh;  // rest mesh in the centre-of-mass frame
   StaticProperties properties;
@@ -45,5 +49,10 @@ struct Trajectory {
 // Fills `scene` with frames t-h … t of the trajectory (kinematic objects also get frame t+1),
 // reusing its buffers. Requires h <= t and, for kinematic objects, t + 1 < num_frames().
 void scene_at_frame(const Trajectory& trajectory, int t, int history, Scene& scene);
+
+// Whether object `o` undergoes an impact at frame t: its centre's acceleration into the next
+// frame, (x^{t+1} − 2x^t + x^{t−1}) / dt², departs from gravity by more than impact_g·|g|.
+// Requires 1 <= t and t + 1 < num_frames().
+bool is_impact(const Trajectory& trajectory, size_t o, int t, double impact_g);
 
 }  // namespace fignet

@@ -27,8 +27,8 @@ struct OneStepOptions {
   double rest_speed = kRestSpeed;    // m/s of the centre of mass
   double rest_angular_speed = 0.25;  // rad/s
   // Impact: the truth's centre-of-mass acceleration differs from gravity by more than this many
-  // g (resting contact differs by one g).
-  double impact_g = 2.0;
+  // g (is_impact).
+  double impact_g = kImpactG;
   std::function<void(int done)> on_trajectory;  // progress: called after each trajectory
 };
 

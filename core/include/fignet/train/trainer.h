@@ -46,7 +46,7 @@ struct TrainerConfig {
   // unweighted loss almost nothing.
   float rest_loss_weight = 1.0f;
   // Weight in the loss of the nodes of bodies that undergo an impact in the truth at the sample's
-  // frame (impact_objects: the centre's acceleration departs from gravity by more than
+  // frame (mark_impacts: the centre's acceleration departs from gravity by more than
   // kImpactG·g; 1: no different from the others). An eighth of the object-steps, they carry most
   // of the rollout error and come out too soft.
   float impact_loss_weight = 1.0f;
@@ -191,7 +191,7 @@ class Trainer {
     std::vector<Points> scene_targets;
     // Per scene, per object: what the body does in the truth (BodyMotion), only when a loss
     // weight is set or the push skips resting bodies.
-    std::vector<std::vector<std::uint8_t>> scene_resting;
+    std::vector<std::vector<std::uint8_t>> scene_motion;
     std::vector<std::uint64_t> scene_seeds;
     // Per scene: how many frames early it was drawn to be pushed forward before the step
     // (pushforward_fraction, pushforward_steps; 0: not pushed), and its turn about the vertical
@@ -209,7 +209,7 @@ class Trainer {
     std::vector<Scene> kept_scenes;
     std::vector<SceneContacts> kept_contacts;
     std::vector<Points> kept_targets;
-    std::vector<std::vector<std::uint8_t>> kept_resting;
+    std::vector<std::vector<std::uint8_t>> kept_motion;
     Graph graph;
     RowMatrixXf targets;
     std::vector<std::uint8_t> in_loss;
@@ -254,7 +254,7 @@ class Trainer {
   }
   // Whose samples carry the bodies' motion flags: those weighed in the loss or kept out of the
   // push.
-  bool flags_rest() const { return weighs_bodies() || trainer_config_.pushforward_skips_rest; }
+  bool flags_motion() const { return weighs_bodies() || trainer_config_.pushforward_skips_rest; }
   // Scales grads_ to trainer_config_.gradient_clip when longer.
   void clip_gradient();
   // averaged_params_ ← d·averaged_params_ + (1 − d)·params_, d = weight_average.

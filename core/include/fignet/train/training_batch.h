@@ -73,18 +73,14 @@ void turn_about_vertical(double angle, Scene& scene, Points& targets);
 // What a body does in the truth around a sample's frame, as the loss weighs it.
 enum BodyMotion : std::uint8_t { kMoving = 0, kResting = 1, kImpact = 2 };
 
-// An impact: the centre's acceleration departs from gravity by more than this many g (the
-// one-step evaluation's impacts, OneStepOptions::impact_g).
-inline constexpr double kImpactG = 2.0;
-
 // Per object of the trajectory: kResting where the body is dynamic and at rest in the truth
 // around the sample, that is every vertex moves less than `max_step` metres over frame − 1 →
 // frame and frame → frame + 1 (a body at the top of a free flight still moves g·dt/2 per step);
 // kMoving elsewhere.
 std::vector<std::uint8_t> resting_objects(const Trajectory& trajectory, int frame, double max_step);
 
-// Marks kImpact on the dynamic bodies flagged kMoving whose centre's acceleration into the next
-// frame, (x^{t+1} − 2x^t + x^{t−1}) / dt², departs from gravity by more than impact_g·|g|.
+// Marks kImpact on the dynamic bodies flagged kMoving that undergo an impact at the frame
+// (is_impact).
 void mark_impacts(const Trajectory& trajectory, int frame, double impact_g,
                   std::vector<std::uint8_t>& motion);
 
