@@ -21,6 +21,14 @@ contact relative to the run NAME (its file name, or the one run whose name start
 the same samples, in per cent (−12.0 % is 12 % below NAME's); "—" where NAME has no validation
 at those samples.
 
+Logs that record each validation trajectory's error (`valid_per_trajectory_translation_m`, from
+2026-12-05) compare scene by scene: the --against cell adds the 95 % interval of the per cent
+over bootstrap resamples of the validation scenes (each drawn with both runs' errors) and on how
+many scenes the run's error is the lower, and a line under the table pools every validation the
+two share (each scene's errors summed over them, the scenes resampled whole). An interval that
+holds 0 does not tell the runs apart on these scenes; the scatter of one run between its own
+validations is another matter, which only more validations or seeds measure.
+
 --fit adds, per log, the learning curve as a power law: a least-squares line through
 ln(translation) against ln(samples) over the validations from --fit-from samples on, its slope
 with the slope's standard error, and where the line reaches at 10x and 100x the last validation's
@@ -179,6 +187,69 @@ def side_by_side(runs, stress_runs, reference_name):
         print("| " + " | ".join(cells) + " |")
 
 
+PER_TRAJECTORY = "valid_per_trajectory_translation_m"
+
+
+def paired_comparison(reference_errors, errors, resamples=10000, seed=1):
+    """The errors' total over the reference's, minus one, scene by scene: (relative, 95 % low,
+    95 % high, scenes where errors is the lower, scenes not tied). The interval is over bootstrap
+    resamples of the scenes, each drawn with both errors (as `fignet eval` does for models)."""
+    import numpy as np
+
+    a = np.asarray(reference_errors, dtype=float)
+    b = np.asarray(errors, dtype=float)
+    picks = np.random.default_rng(seed).integers(0, len(a), size=(resamples, len(a)))
+    totals_a = a[picks].sum(axis=1)
+    ratios = b[picks].sum(axis=1)[totals_a > 0] / totals_a[totals_a > 0] - 1.0
+    low, high = np.quantile(ratios, [0.025, 0.975])
+    return b.sum() / a.sum() - 1.0, low, high, int((b < a).sum()), int((b != a).sum())
+
+
+def paired_text(comparison) -> str:
+    """ "−3.1 % [−6.0, −0.4] 14/20": the per cent, its interval, the scenes won of those not tied."""
+    relative, low, high, lower, untied = comparison
+    return with_minus(f"{100 * relative:+.1f} % [{100 * low:+.1f}, {100 * high:+.1f}] "
+                      f"{lower}/{untied}")
+
+
+def scene_by_scene(entry, other):
+    """The two validations' per-trajectory errors when both have them for the same scenes."""
+    mine, theirs = entry.get(PER_TRAJECTORY), other.get(PER_TRAJECTORY)
+    if mine is None or theirs is None or len(mine) != len(theirs) or not mine:
+        return None
+    if any(x is None for x in mine + theirs):  # a rollout that left the finite numbers
+        return None
+    return theirs, mine
+
+
+def pooled_against(runs, reference_name):
+    """Lines under the table: each run against the reference over every validation they share
+    with per-trajectory errors, each scene's errors summed over those validations."""
+    reference = {v["samples"]: v for v in dict(runs)[reference_name] if v["samples"] is not None}
+    lines = []
+    for name, validations in runs:
+        if name == reference_name:
+            continue
+        mine_sum, theirs_sum, shared = None, None, 0
+        for entry in validations:
+            other = reference.get(entry["samples"])
+            pair = scene_by_scene(entry, other) if other is not None else None
+            if pair is None or (mine_sum is not None and len(pair[1]) != len(mine_sum)):
+                continue
+            theirs, mine = pair
+            if mine_sum is None:
+                mine_sum, theirs_sum = [0.0] * len(mine), [0.0] * len(mine)
+            mine_sum = [x + y for x, y in zip(mine_sum, mine)]
+            theirs_sum = [x + y for x, y in zip(theirs_sum, theirs)]
+            shared += 1
+        if shared:
+            lines.append(f"{name} against {reference_name}, scene by scene over the {shared} "
+                         f"validation(s) both have at equal samples ({len(mine_sum)} scenes, "
+                         f"each summed over them): translation "
+                         f"{paired_text(paired_comparison(theirs_sum, mine_sum))}")
+    return lines
+
+
 def with_minus(text: str) -> str:
     """A figure with the minus sign (−) of the tables instead of a hyphen."""
     return text.replace("-", "−")
@@ -274,10 +345,16 @@ def main() -> int:
                 cells.append(percent_from(entry[key], other[key]))
             else:
                 cells.append("-")
+        pair = scene_by_scene(entry, other)
+        if pair is not None:  # the translation's interval, scene by scene
+            cells[0] = paired_text(paired_comparison(*pair))
         return " / ".join(cells)
 
+    pooled = pooled_against(runs, reference_name) if reference is not None else []
     if args.side_by_side:
         side_by_side(runs, stress_runs, reference_name)
+        for line in pooled:
+            print(f"\n{line}")
         return 0
 
     with_compute = bool(costs)
@@ -303,6 +380,8 @@ def main() -> int:
             print(f"| {name} | {entry['step']} | {samples} |{compute} "
                   f"{entry['valid_translation_m']:.3f} | {entry['valid_rotation_deg']:.1f} "
                   f"| {one_step} |{difference}")
+    for line in pooled:
+        print(f"\n{line}")
 
     fits = {}
     if args.fit or args.plot:

@@ -15,6 +15,7 @@
 #include "fignet/io/trajectory_file.h"
 #include "fignet/rollout/evaluation.h"
 #include "fignet/rollout/one_step.h"
+#include "fignet/rollout/paired_comparison.h"
 #include "process_group.h"
 #include "progress.h"
 #include "text_file.h"
@@ -180,6 +181,68 @@ void print_table(const std::vector<Row>& rows) {
       "truth's (1 = as much as Bullet; nan: not measured or none in the ground truth).\n");
 }
 
+// Each row's rollout errors against the first row's, scene by scene (the rows' per-trajectory
+// errors are of the same trajectories, in the same order). A run whose rollouts left the finite
+// numbers has no comparison: `why_not` says so instead.
+struct PairedRow {
+  std::optional<PairedComparison> translation, rotation;
+  std::string why_not;
+};
+
+std::vector<double> per_trajectory(const Evaluation& e, double RolloutErrors::*field) {
+  std::vector<double> values;
+  for (const RolloutErrors& t : e.per_trajectory) values.push_back(t.*field);
+  return values;
+}
+
+PairedRow paired_against(const Row& reference, const Row& row) {
+  PairedRow paired;
+  try {
+    paired.translation =
+        compare_paired(per_trajectory(reference.result, &RolloutErrors::mean_translation),
+                       per_trajectory(row.result, &RolloutErrors::mean_translation));
+    paired.rotation =
+        compare_paired(per_trajectory(reference.result, &RolloutErrors::mean_rotation),
+                       per_trajectory(row.result, &RolloutErrors::mean_rotation));
+  } catch (const ConfigError& e) {
+    paired = {std::nullopt, std::nullopt, e.what()};
+  }
+  return paired;
+}
+
+std::string paired_cell(const std::optional<PairedComparison>& c) {
+  if (!c) return "-";
+  return fmt::format("{:+.1f}% [{:+.1f}, {:+.1f}] {}/{} p={:.2g}", 100 * c->relative,
+                     100 * c->relative_low, 100 * c->relative_high, c->b_lower,
+                     c->b_lower + c->a_lower, c->sign_test_p);
+}
+
+void print_paired(const std::vector<Row>& rows) {
+  fmt::print("\nagainst {} ({}), scene by scene\n", rows.front().name, rows.front().kind);
+  fmt::print("{:<34} {:>38} {:>38}\n", "run", "mean translation", "mean rotation");
+  for (size_t k = 1; k < rows.size(); ++k) {
+    const PairedRow paired = paired_against(rows.front(), rows[k]);
+    fmt::print("{:<34} {:>38} {:>38}{}\n", fmt::format("{} ({})", rows[k].name, rows[k].kind),
+               paired_cell(paired.translation), paired_cell(paired.rotation),
+               paired.why_not.empty() ? "" : "  " + paired.why_not);
+  }
+  fmt::print(
+      "\nper cent: the run's mean error over the first's, minus one; [..]: 95 % interval of it "
+      "over 10,000 bootstrap resamples of the scenes (each drawn with both runs' errors); k/n: "
+      "the scenes where the run's error is the lower, of those not tied; p: two-sided sign test "
+      "of that count. An interval that holds 0 does not tell the two apart on these scenes.\n");
+}
+
+nlohmann::json to_json(const std::optional<PairedComparison>& c) {
+  if (!c) return nullptr;
+  return {{"relative", c->relative},
+          {"relative_low_95", c->relative_low},
+          {"relative_high_95", c->relative_high},
+          {"lower_scenes", c->b_lower},
+          {"higher_scenes", c->a_lower},
+          {"sign_test_p", c->sign_test_p}};
+}
+
 nlohmann::json to_json(const Row& row) {
   const Evaluation& e = row.result;
   const auto number = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nullptr; };
@@ -271,6 +334,7 @@ void run_eval(const EvalArgs& args) {
              args.frames > 0 ? args.frames : test[0].num_frames(), history + 1,
              fmt::join(files, ", "));
   print_table(rows);
+  if (rows.size() > 1) print_paired(rows);
   if (regimes) print_regimes(rows);
   if (!args.json.empty()) {
     nlohmann::json out = {{"data", nlohmann::json::array()},
@@ -279,7 +343,16 @@ void run_eval(const EvalArgs& args) {
                           {"frame_step_s", test[0].time_step},
                           {"runs", nlohmann::json::array()}};
     out["data"] = files;
-    for (const Row& row : rows) out["runs"].push_back(to_json(row));
+    for (const Row& row : rows) {
+      out["runs"].push_back(to_json(row));
+      // Against the first run, scene by scene (absent from the first run itself).
+      if (&row != &rows.front()) {
+        const PairedRow paired = paired_against(rows.front(), row);
+        out["runs"].back()["paired_against_first"] = {
+            {"mean_translation", to_json(paired.translation)},
+            {"mean_rotation", to_json(paired.rotation)}};
+      }
+    }
     write_text_atomically(args.json, out.dump(2) + "\n");
     fmt::print("results: {}\n", args.json.string());
   }

@@ -86,6 +86,15 @@ void TrainingLog::write_validation(std::int64_t step, const Evaluation& e,
   }
   line["valid_one_step_m_impacts"] = mean_translation(one_step.impact_errors);
   line["valid_one_step_ahead_m_impacts"] = mean_ahead(one_step.impact_errors);
+  // Every validation trajectory's own errors, in order: two runs on the same validation split
+  // compare scene by scene (scripts/training-log.py --against), far more sharply than by means.
+  nlohmann::json translations = nlohmann::json::array(), rotations = nlohmann::json::array();
+  for (const RolloutErrors& t : e.per_trajectory) {
+    translations.push_back(t.mean_translation);
+    rotations.push_back(t.mean_rotation);
+  }
+  line["valid_per_trajectory_translation_m"] = std::move(translations);
+  line["valid_per_trajectory_rotation_deg"] = std::move(rotations);
   out_ << line.dump() << std::endl;
 }
 

@@ -124,6 +124,52 @@ def test_against_gives_each_run_its_difference_at_equal_samples(source_dir, tmp_
         assert result.returncode == 2 and said in result.stderr, result.stderr
 
 
+def write_scene_log(path, validations):
+    """A log of (samples, per-trajectory translations) validations, as fignet train writes them
+    since it records each validation scene's error."""
+    with open(path, "w") as log:
+        for samples, errors in validations:
+            log.write(json.dumps({"step": samples // 8, "samples": samples,
+                                  "valid_translation_m": sum(errors) / len(errors),
+                                  "valid_rotation_deg": 40.0,
+                                  "valid_per_trajectory_translation_m": errors}) + "\n")
+
+
+def test_against_compares_scene_by_scene_where_logs_have_each_scenes_error(source_dir, tmp_path):
+    # Every scene 10 % lower: every resample says −10 %, and the run wins all five scenes. One
+    # scene three times worse and the rest 10 % lower: nearly level, an interval across 0.
+    base = [0.2, 0.5, 1.0, 0.3, 0.8]
+    write_scene_log(tmp_path / "base.h5.log.jsonl", [(10_000, base), (20_000, base)])
+    write_scene_log(tmp_path / "lower.h5.log.jsonl",
+                    [(10_000, [0.9 * e for e in base]), (20_000, [0.9 * e for e in base])])
+    mixed = [0.9] * 19 + [3.0]
+    write_scene_log(tmp_path / "flat.h5.log.jsonl", [(10_000, [1.0] * 20)])
+    write_scene_log(tmp_path / "mixed.h5.log.jsonl", [(10_000, mixed)])
+    logs = [str(tmp_path / f"{n}.h5.log.jsonl") for n in ("base", "lower")]
+    result = run_training_log(source_dir, "--against", "base", *logs)
+    assert result.returncode == 0, result.stderr
+    cells = {(row[0], row[2]): row[-1] for row in table_rows(result.stdout)}
+    assert cells[("lower", "10k")] == "−10.0 % [−10.0, −10.0] 5/5 / -", result.stdout
+    assert ("lower against base, scene by scene over the 2 validation(s) both have at equal "
+            "samples (5 scenes, each summed over them): translation −10.0 % [−10.0, −10.0] 5/5"
+            in result.stdout)
+    result = run_training_log(source_dir, "--side-by-side", "--against", "flat",
+                              *(str(tmp_path / f"{n}.h5.log.jsonl") for n in ("flat", "mixed")))
+    assert result.returncode == 0, result.stderr
+    line = [text for text in result.stdout.splitlines() if text.startswith("mixed against")][0]
+    match = re.search(r"translation ([+−]\d+\.\d) % \[([+−]\d+\.\d), ([+−]\d+\.\d)\] 19/20", line)
+    assert match, line
+    relative, low, high = (float(g.replace("−", "-")) for g in match.groups())
+    assert relative == round(100 * (sum(mixed) / 20 - 1), 1) and low < 0 < high
+    # Logs from before the per-scene errors keep the plain per cent.
+    write_log(tmp_path / "old.h5.log.jsonl", [(10_000, 0.5)])
+    result = run_training_log(source_dir, "--against", "old", str(tmp_path / "old.h5.log.jsonl"),
+                              logs[0])
+    cells = {(row[0], row[2]): row[-1] for row in table_rows(result.stdout)}
+    assert cells[("base", "10k")] == "+12.0 % / -", result.stdout
+    assert "scene by scene" not in result.stdout
+
+
 def test_batch_counts_samples_of_old_logs_by_the_longest_prefix(source_dir, tmp_path):
     # Logs from before the "samples" field: steps × the batch given for the longest prefix of
     # the run's name, as --cost decides.
