@@ -213,7 +213,8 @@ def paired_text(comparison) -> str:
 
 
 def scene_by_scene(entry, other):
-    """The two validations' per-trajectory errors when both have them for the same scenes."""
+    """(other's, entry's) per-trajectory errors, the reference's first as paired_comparison
+    takes them, when both validations have them for the same scenes; None otherwise."""
     mine, theirs = entry.get(PER_TRAJECTORY), other.get(PER_TRAJECTORY)
     if mine is None or theirs is None or len(mine) != len(theirs) or not mine:
         return None

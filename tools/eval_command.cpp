@@ -217,20 +217,23 @@ std::string paired_cell(const std::optional<PairedComparison>& c) {
                      c->b_lower + c->a_lower, c->sign_test_p);
 }
 
-void print_paired(const std::vector<Row>& rows) {
+// paired[k] is rows[k + 1] against rows[0].
+void print_paired(const std::vector<Row>& rows, const std::vector<PairedRow>& paired) {
   fmt::print("\nagainst {} ({}), scene by scene\n", rows.front().name, rows.front().kind);
   fmt::print("{:<34} {:>38} {:>38}\n", "run", "mean translation", "mean rotation");
-  for (size_t k = 1; k < rows.size(); ++k) {
-    const PairedRow paired = paired_against(rows.front(), rows[k]);
-    fmt::print("{:<34} {:>38} {:>38}{}\n", fmt::format("{} ({})", rows[k].name, rows[k].kind),
-               paired_cell(paired.translation), paired_cell(paired.rotation),
-               paired.why_not.empty() ? "" : "  " + paired.why_not);
+  for (size_t k = 0; k < paired.size(); ++k) {
+    const Row& row = rows[k + 1];
+    fmt::print("{:<34} {:>38} {:>38}{}\n", fmt::format("{} ({})", row.name, row.kind),
+               paired_cell(paired[k].translation), paired_cell(paired[k].rotation),
+               paired[k].why_not.empty() ? "" : "  " + paired[k].why_not);
   }
+  const PairedComparisonOptions options;
   fmt::print(
-      "\nper cent: the run's mean error over the first's, minus one; [..]: 95 % interval of it "
-      "over 10,000 bootstrap resamples of the scenes (each drawn with both runs' errors); k/n: "
+      "\nper cent: the run's mean error over the first's, minus one; [..]: {:.0f} % interval of "
+      "it over {} bootstrap resamples of the scenes (each drawn with both runs' errors); k/n: "
       "the scenes where the run's error is the lower, of those not tied; p: two-sided sign test "
-      "of that count. An interval that holds 0 does not tell the two apart on these scenes.\n");
+      "of that count. An interval that holds 0 does not tell the two apart on these scenes.\n",
+      100 * options.confidence, options.resamples);
 }
 
 nlohmann::json to_json(const std::optional<PairedComparison>& c) {
@@ -333,8 +336,11 @@ void run_eval(const EvalArgs& args) {
   fmt::print("{} trajectories, {} frames each ({} given), from {}\n", trajectories,
              args.frames > 0 ? args.frames : test[0].num_frames(), history + 1,
              fmt::join(files, ", "));
+  // Every run after the first against the first, once for the table and the JSON.
+  std::vector<PairedRow> paired;
+  for (size_t k = 1; k < rows.size(); ++k) paired.push_back(paired_against(rows.front(), rows[k]));
   print_table(rows);
-  if (rows.size() > 1) print_paired(rows);
+  if (!paired.empty()) print_paired(rows, paired);
   if (regimes) print_regimes(rows);
   if (!args.json.empty()) {
     nlohmann::json out = {{"data", nlohmann::json::array()},
@@ -343,14 +349,13 @@ void run_eval(const EvalArgs& args) {
                           {"frame_step_s", test[0].time_step},
                           {"runs", nlohmann::json::array()}};
     out["data"] = files;
-    for (const Row& row : rows) {
-      out["runs"].push_back(to_json(row));
+    for (size_t k = 0; k < rows.size(); ++k) {
+      out["runs"].push_back(to_json(rows[k]));
       // Against the first run, scene by scene (absent from the first run itself).
-      if (&row != &rows.front()) {
-        const PairedRow paired = paired_against(rows.front(), row);
+      if (k > 0) {
         out["runs"].back()["paired_against_first"] = {
-            {"mean_translation", to_json(paired.translation)},
-            {"mean_rotation", to_json(paired.rotation)}};
+            {"mean_translation", to_json(paired[k - 1].translation)},
+            {"mean_rotation", to_json(paired[k - 1].rotation)}};
       }
     }
     write_text_atomically(args.json, out.dump(2) + "\n");
