@@ -197,13 +197,16 @@ std::vector<double> per_trajectory(const Evaluation& e, double RolloutErrors::*f
 
 PairedRow paired_against(const Row& reference, const Row& row) {
   PairedRow paired;
+  PairedComparisonOptions options;
+  options.a_name = reference.name;
+  options.b_name = row.name;
   try {
     paired.translation =
         compare_paired(per_trajectory(reference.result, &RolloutErrors::mean_translation),
-                       per_trajectory(row.result, &RolloutErrors::mean_translation));
+                       per_trajectory(row.result, &RolloutErrors::mean_translation), options);
     paired.rotation =
         compare_paired(per_trajectory(reference.result, &RolloutErrors::mean_rotation),
-                       per_trajectory(row.result, &RolloutErrors::mean_rotation));
+                       per_trajectory(row.result, &RolloutErrors::mean_rotation), options);
   } catch (const ConfigError& e) {
     paired = {std::nullopt, std::nullopt, e.what()};
   }

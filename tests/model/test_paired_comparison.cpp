@@ -116,6 +116,11 @@ TEST(PairedComparison, BadInputNamesWhatIsWrong) {
   expect_error(zeros, three, "all zero");
   expect_error(three, three, "10 resamples", {.resamples = 10});
   expect_error(three, three, "confidence 1", {.confidence = 1.0});
+  expect_error(not_finite, three, "models/old.h5's error 1 is nan",
+               {.a_name = "models/old.h5", .b_name = "models/new.h5"});
+  expect_error(three, negative, "models/new.h5's error 1 is -0.2",
+               {.a_name = "models/old.h5", .b_name = "models/new.h5"});
+  expect_error(zeros, three, "models/old.h5's errors are all zero", {.a_name = "models/old.h5"});
 }
 
 }  // namespace

@@ -27,7 +27,7 @@ double quantile(const std::vector<double>& sorted, double q) {
   return sorted[below] + (at - static_cast<double>(below)) * (sorted[above] - sorted[below]);
 }
 
-void check_errors(std::span<const double> values, const char* which) {
+void check_errors(std::span<const double> values, const std::string& which) {
   for (std::size_t i = 0; i < values.size(); ++i) {
     if (!std::isfinite(values[i]) || values[i] < 0) {
       throw ConfigError(
@@ -74,8 +74,8 @@ PairedComparison compare_paired(std::span<const double> a, std::span<const doubl
     throw ConfigError(
         fmt::format("paired comparison: confidence {} is not between 0 and 1", options.confidence));
   }
-  check_errors(a, "a");
-  check_errors(b, "b");
+  check_errors(a, options.a_name);
+  check_errors(b, options.b_name);
   const std::size_t n = a.size();
 
   PairedComparison result;
@@ -87,7 +87,9 @@ PairedComparison compare_paired(std::span<const double> a, std::span<const doubl
     result.b_lower += b[i] < a[i];
     result.a_lower += a[i] < b[i];
   }
-  if (sum_a == 0) throw ConfigError("paired comparison: a's errors are all zero");
+  if (sum_a == 0) {
+    throw ConfigError(fmt::format("paired comparison: {}'s errors are all zero", options.a_name));
+  }
   result.mean_a = sum_a / static_cast<double>(n);
   result.mean_b = sum_b / static_cast<double>(n);
   result.relative = sum_b / sum_a - 1.0;

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
 
 namespace fignet {
 
@@ -28,10 +29,13 @@ struct PairedComparisonOptions {
   int resamples = 10000;
   double confidence = 0.95;
   std::uint64_t seed = 1;  // the same seed gives the same interval on every platform
+  // What error messages call the two runs (e.g. the models' paths).
+  std::string a_name = "a", b_name = "b";
 };
 
 // Throws ConfigError when the spans differ in length or are empty, when a value is negative or
-// not finite, or when a's errors are all zero (no relative difference).
+// not finite, or when a's errors are all zero (no relative difference); the message names the
+// runs by `a_name` and `b_name`.
 PairedComparison compare_paired(std::span<const double> a, std::span<const double> b,
                                 const PairedComparisonOptions& options = {});
 
