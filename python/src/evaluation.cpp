@@ -1,12 +1,15 @@
 // The metrics of `fignet eval` on Python inputs: per-frame translation (RMSE over dynamic
-// objects) and rotation errors of a rollout, from trajectories or from numpy poses, and a whole
-// evaluation of a model over a set of trajectories.
+// objects) and rotation errors of a rollout, from trajectories or from numpy poses, a whole
+// evaluation of a model over a set of trajectories, and two runs' errors compared scene by scene.
 #include <pybind11/stl.h>
+
+#include <cstdint>
 
 #include <fmt/format.h>
 
 #include "bindings.h"
 #include "fignet/rollout/evaluation.h"
+#include "fignet/rollout/paired_comparison.h"
 
 namespace fignet::python {
 
@@ -143,6 +146,34 @@ angle (degrees); their means over frames first_predicted … end and their last 
       R"(Rolls every trajectory out with the network alone and summarises as `fignet eval --json`
 does (the same keys; `turns` as its --turns): mean and last-frame errors averaged over trajectories, per-frame means,
 penetration ratios when asked (costly), and each trajectory's errors.)");
+  m.def(
+      "compare_paired",
+      [](const std::vector<double>& a, const std::vector<double>& b, int resamples,
+         double confidence, std::uint64_t seed) {
+        const PairedComparisonOptions options{
+            .resamples = resamples, .confidence = confidence, .seed = seed};
+        const PairedComparison c = compare_paired(a, b, options);
+        py::dict out;
+        out["pairs"] = c.pairs;
+        out["mean_a"] = c.mean_a;
+        out["mean_b"] = c.mean_b;
+        out["relative"] = c.relative;
+        out["relative_low"] = c.relative_low;
+        out["relative_high"] = c.relative_high;
+        out["b_lower"] = c.b_lower;
+        out["a_lower"] = c.a_lower;
+        out["sign_test_p"] = c.sign_test_p;
+        return out;
+      },
+      py::arg("a"), py::arg("b"), py::arg("resamples") = 10000, py::arg("confidence") = 0.95,
+      py::arg("seed") = 1,
+      R"(Two runs' errors on the same scenes (a[i] and b[i] of scene i), as `fignet eval`
+compares each model with the first: "relative" is mean(b) / mean(a) - 1, "relative_low" and
+"relative_high" its percentile interval (`confidence`) over `resamples` bootstrap resamples of
+the scenes (each drawn with both errors), "b_lower" / "a_lower" the scenes each run's error is
+the lower on (ties in neither) and "sign_test_p" the two-sided exact sign test of that split.
+The same seed gives the same interval as `fignet eval`. Raises ConfigError on lists of different
+lengths, negative or non-finite errors, or a's errors all zero.)");
 }
 
 }  // namespace fignet::python
