@@ -578,38 +578,54 @@ struct FIGNetDynamicsWorld::Impl {
     }
   }
 
-  // The tunnelling guard. A step longer than the collision radius can carry a body past a surface
-  // that was never within the graph's reach; such a step is swept with the body's convex shape
-  // (or, for compounds, a sphere inside it) and, if it would cross a surface it moves against,
-  // the body stops where it touches, as Bullet's CCD stops a body.
+  // The tunnelling guard, by Bullet's CCD rule: a step longer than the collision radius is swept
+  // with a sphere deep inside the body (Bullet's swept sphere), and only a step that would carry
+  // that core into a surface is the guard's. Contacts the graph reaches, and the shallow
+  // penetrations of fast impacts, are the network's (and the penetration guard's): the data
+  // holds them, and stopping a body at every surface it nears at training speeds took its
+  // velocity at every impact. A guarded body stops where its own shape first touches the
+  // surface (convex shapes; the core's hit for others) and keeps its velocity along it; the part
+  // into it goes, history included, as the penetration guard's does.
   void guard_fast_bodies(btCollisionWorld& world) {
     if (!options.sweep_guard) return;
     for (size_t i = 0; i < moving.size(); ++i) {
       btRigidBody& body = *moving[i];
-      const Pose& current = states[&body].poses.back();
+      BodyState& state = states[&body];
+      const Pose current = state.poses.back();
       Pose& next_pose = next[i];
       const Vec3 motion = next_pose.position - current.position;
       if (motion.norm() <= graph.collision_radius) continue;
-      const btCollisionShape* shape = body.getCollisionShape();
-      std::unique_ptr<btSphereShape> inner;
-      const btConvexShape* swept = nullptr;
-      if (shape->isConvex()) {
-        swept = static_cast<const btConvexShape*>(shape);
-      } else {
-        btVector3 low, high;
-        shape->getAabb(btTransform::getIdentity(), low, high);
-        const btVector3 size = high - low;
-        inner = std::make_unique<btSphereShape>(0.25f * size[size.minAxis()]);
-        swept = inner.get();
-      }
-      Pose from = current, to = current;
+      Pose to = current;
       to.position = next_pose.position;
-      SweepCallback hit(&body, to_bt(from.position), to_bt(to.position));
-      world.convexSweepTest(swept, to_bt(from), to_bt(to), hit);
-      if (!hit.hasHit()) continue;
-      const double fraction = hit.m_closestHitFraction;
+      // The core: half the body's smallest half-width, about its centre of mass.
+      const btCollisionShape* shape = body.getCollisionShape();
+      btVector3 low, high;
+      shape->getAabb(btTransform::getIdentity(), low, high);
+      const btVector3 size = high - low;
+      const btSphereShape core(0.25f * size[size.minAxis()]);
+      SweepCallback core_hit(&body, to_bt(current.position), to_bt(to.position));
+      world.convexSweepTest(&core, to_bt(current), to_bt(to), core_hit);
+      if (!core_hit.hasHit()) continue;
+      double fraction = core_hit.m_closestHitFraction;
+      Vec3 normal = from_bt(core_hit.m_hitNormalWorld);
+      if (shape->isConvex()) {
+        SweepCallback touch(&body, to_bt(current.position), to_bt(to.position));
+        world.convexSweepTest(static_cast<const btConvexShape*>(shape), to_bt(current), to_bt(to),
+                              touch);
+        if (touch.hasHit() && touch.m_closestHitFraction <= fraction) {
+          fraction = touch.m_closestHitFraction;
+          normal = from_bt(touch.m_hitNormalWorld);
+        }
+      }
       next_pose.position = current.position + fraction * motion;
       next_pose.orientation = current.orientation.slerp(fraction, next_pose.orientation);
+      // v' = v − min(0, v·n)·n with v the predicted velocity; write_back reads the velocity off
+      // the history, so the history moves to end v'·dt behind the stop.
+      if (normal.norm() > 0) normal.normalize();
+      const Vec3 velocity = motion / time_step;
+      const Vec3 kept = velocity - std::min(0.0, velocity.dot(normal)) * normal;
+      const Vec3 shift = next_pose.position - kept * time_step - current.position;
+      for (Pose& pose : state.poses) pose.position += shift;
       ++stats.guarded_bodies;
     }
   }

@@ -29,9 +29,10 @@ struct FIGNetWorldOptions {
   // Broadphase boxes grow by d_c plus the distance a body moved in its last step, so a fast body
   // still finds what it is about to hit (false: d_c only, as in training).
   bool grow_search_by_travel = true;
-  // The tunnelling guard: a body whose predicted step is longer than the collision radius has its
-  // motion swept against the world (Bullet's convex cast, as Bullet's own CCD does) and stops at
-  // the first surface it would cross; the model decides everything slower.
+  // The tunnelling guard: a body whose predicted step is longer than the collision radius has a
+  // sphere deep inside it swept along the step (Bullet's CCD rule); if that core would cross a
+  // surface, the body stops where its shape touches it and keeps only its velocity along it.
+  // Contacts and shallower penetrations, at any speed, are the model's.
   bool sweep_guard = true;
   // Free flight: a body with no collision edge this step (nothing within d_c, the floor
   // included) moves exactly under gravity and its applied forces (constant angular velocity),
