@@ -4,7 +4,9 @@
 // self-contained HTML report with a 3D player, error plots and the speed–accuracy chart.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <optional>
 
 #include "commands.h"
 #include "fignet/bullet/comparison.h"
@@ -13,6 +15,7 @@
 #include "fignet/io/trajectory_file.h"
 #include "progress.h"
 #include "report_html.h"
+#include "scene_by_scene.h"
 #include "text_file.h"
 
 namespace fignet::cli {
@@ -43,6 +46,40 @@ void print_table(const std::vector<bullet::RunResult>& results) {
       "\nErrors against the ground truth, every run started from the same first frame; x real: "
       "simulated seconds per wall-clock second on this machine. The chaos floor is how far "
       "Bullet drifts from itself after a 1e-6 m nudge: no simulator can be asked to beat it.\n");
+}
+
+// The runs against Bullet at the model's own step, scene by scene: the cheap native setting a
+// learned simulator has to beat (index-aligned with results; none for the ground truth and it).
+std::vector<std::optional<SceneBySceneRow>> against_coarse_bullet(
+    const std::vector<bullet::RunResult>& results, const std::string& reference) {
+  std::vector<std::optional<SceneBySceneRow>> rows(results.size());
+  const auto found = std::find_if(results.begin(), results.end(), [&](const bullet::RunResult& r) {
+    return r.run.name == reference;
+  });
+  if (found == results.end() || results.front().errors.size() < 2) return rows;
+  for (size_t k = 1; k < results.size(); ++k) {
+    if (&results[k] == &*found) continue;
+    rows[k] = compare_scene_by_scene(found->errors, results[k].errors, found->run.name,
+                                     results[k].run.name);
+  }
+  return rows;
+}
+
+void print_against(const std::vector<bullet::RunResult>& results, const std::string& reference,
+                   const std::vector<std::optional<SceneBySceneRow>>& rows) {
+  if (std::none_of(rows.begin(), rows.end(), [](const auto& row) { return row.has_value(); })) {
+    return;
+  }
+  fmt::print("\nagainst {}, scene by scene\n", reference);
+  fmt::print("{:<48} {:>38} {:>38}\n", "run", "mean translation", "mean rotation");
+  for (size_t k = 0; k < rows.size(); ++k) {
+    if (!rows[k]) continue;
+    fmt::print("{:<48} {:>38} {:>38}{}\n",
+               fmt::format("{} ({})", results[k].run.name, results[k].run.kind),
+               scene_by_scene_cell(rows[k]->translation), scene_by_scene_cell(rows[k]->rotation),
+               rows[k]->why_not.empty() ? "" : "  " + rows[k]->why_not);
+  }
+  fmt::print("\n{}\n", scene_by_scene_legend());
 }
 
 void run_compare(const CompareArgs& args) {
@@ -81,8 +118,12 @@ void run_compare(const CompareArgs& args) {
   fmt::print("{} scenes from {}, {} frames of {:.4f} s\n", scenes.size(), args.data.string(),
              scenes[0].frames, scenes[0].frame_step());
   print_table(results);
+  const std::string reference = bullet::kCoarseBulletRun;
+  const std::vector<std::optional<SceneBySceneRow>> against =
+      against_coarse_bullet(results, reference);
+  print_against(results, reference, against);
 
-  const ReportInput input{args.data.string(), scenes, results};
+  const ReportInput input{args.data.string(), scenes, results, reference, against};
   write_text_atomically(args.report, render_report_html(input));
   fmt::print("report: {}\n", fs::absolute(args.report).string());
   if (!args.json.empty()) {

@@ -15,9 +15,9 @@
 #include "fignet/io/trajectory_file.h"
 #include "fignet/rollout/evaluation.h"
 #include "fignet/rollout/one_step.h"
-#include "fignet/rollout/paired_comparison.h"
 #include "process_group.h"
 #include "progress.h"
+#include "scene_by_scene.h"
 #include "text_file.h"
 
 namespace fignet::cli {
@@ -182,71 +182,23 @@ void print_table(const std::vector<Row>& rows) {
 }
 
 // Each row's rollout errors against the first row's, scene by scene (the rows' per-trajectory
-// errors are of the same trajectories, in the same order). A run whose rollouts left the finite
-// numbers has no comparison: `why_not` says so instead.
-struct PairedRow {
-  std::optional<PairedComparison> translation, rotation;
-  std::string why_not;
-};
-
-std::vector<double> per_trajectory(const Evaluation& e, double RolloutErrors::*field) {
-  std::vector<double> values;
-  for (const RolloutErrors& t : e.per_trajectory) values.push_back(t.*field);
-  return values;
-}
-
-PairedRow paired_against(const Row& reference, const Row& row) {
-  PairedRow paired;
-  PairedComparisonOptions options;
-  options.a_name = reference.name;
-  options.b_name = row.name;
-  try {
-    paired.translation =
-        compare_paired(per_trajectory(reference.result, &RolloutErrors::mean_translation),
-                       per_trajectory(row.result, &RolloutErrors::mean_translation), options);
-    paired.rotation =
-        compare_paired(per_trajectory(reference.result, &RolloutErrors::mean_rotation),
-                       per_trajectory(row.result, &RolloutErrors::mean_rotation), options);
-  } catch (const ConfigError& e) {
-    paired = {std::nullopt, std::nullopt, e.what()};
-  }
-  return paired;
-}
-
-std::string paired_cell(const std::optional<PairedComparison>& c) {
-  if (!c) return "-";
-  return fmt::format("{:+.1f}% [{:+.1f}, {:+.1f}] {}/{} p={:.2g}", 100 * c->relative,
-                     100 * c->relative_low, 100 * c->relative_high, c->b_lower,
-                     c->b_lower + c->a_lower, c->sign_test_p);
+// errors are of the same trajectories, in the same order).
+SceneBySceneRow paired_against(const Row& reference, const Row& row) {
+  return compare_scene_by_scene(reference.result.per_trajectory, row.result.per_trajectory,
+                                reference.name, row.name);
 }
 
 // paired[k] is rows[k + 1] against rows[0].
-void print_paired(const std::vector<Row>& rows, const std::vector<PairedRow>& paired) {
+void print_paired(const std::vector<Row>& rows, const std::vector<SceneBySceneRow>& paired) {
   fmt::print("\nagainst {} ({}), scene by scene\n", rows.front().name, rows.front().kind);
   fmt::print("{:<34} {:>38} {:>38}\n", "run", "mean translation", "mean rotation");
   for (size_t k = 0; k < paired.size(); ++k) {
     const Row& row = rows[k + 1];
     fmt::print("{:<34} {:>38} {:>38}{}\n", fmt::format("{} ({})", row.name, row.kind),
-               paired_cell(paired[k].translation), paired_cell(paired[k].rotation),
+               scene_by_scene_cell(paired[k].translation), scene_by_scene_cell(paired[k].rotation),
                paired[k].why_not.empty() ? "" : "  " + paired[k].why_not);
   }
-  const PairedComparisonOptions options;
-  fmt::print(
-      "\nper cent: the run's mean error over the first's, minus one; [..]: {:.0f} % interval of "
-      "it over {} bootstrap resamples of the scenes (each drawn with both runs' errors); k/n: "
-      "the scenes where the run's error is the lower, of those not tied; p: two-sided sign test "
-      "of that count. An interval that holds 0 does not tell the two apart on these scenes.\n",
-      100 * options.confidence, options.resamples);
-}
-
-nlohmann::json to_json(const std::optional<PairedComparison>& c) {
-  if (!c) return nullptr;
-  return {{"relative", c->relative},
-          {"relative_low_95", c->relative_low},
-          {"relative_high_95", c->relative_high},
-          {"lower_scenes", c->b_lower},
-          {"higher_scenes", c->a_lower},
-          {"sign_test_p", c->sign_test_p}};
+  fmt::print("\n{}\n", scene_by_scene_legend());
 }
 
 nlohmann::json to_json(const Row& row) {
@@ -340,7 +292,7 @@ void run_eval(const EvalArgs& args) {
              args.frames > 0 ? args.frames : test[0].num_frames(), history + 1,
              fmt::join(files, ", "));
   // Every run after the first against the first, once for the table and the JSON.
-  std::vector<PairedRow> paired;
+  std::vector<SceneBySceneRow> paired;
   for (size_t k = 1; k < rows.size(); ++k) paired.push_back(paired_against(rows.front(), rows[k]));
   print_table(rows);
   if (!paired.empty()) print_paired(rows, paired);
@@ -357,8 +309,8 @@ void run_eval(const EvalArgs& args) {
       // Against the first run, scene by scene (absent from the first run itself).
       if (k > 0) {
         out["runs"].back()["paired_against_first"] = {
-            {"mean_translation", to_json(paired[k - 1].translation)},
-            {"mean_rotation", to_json(paired[k - 1].rotation)}};
+            {"mean_translation", scene_by_scene_json(paired[k - 1].translation)},
+            {"mean_rotation", scene_by_scene_json(paired[k - 1].rotation)}};
       }
     }
     write_text_atomically(args.json, out.dump(2) + "\n");

@@ -71,6 +71,13 @@ nlohmann::json report_json(const ReportInput& input, bool with_poses) {
                           {"final_rotation_deg", rounded(r.final_rotation)},
                           {"translation_per_frame_m", rounded_list(r.translation)},
                           {"rotation_per_frame_deg", rounded_list(r.rotation)}};
+    const size_t k = runs.size();
+    if (k < input.against_reference.size() && input.against_reference[k]) {
+      const SceneBySceneRow& row = *input.against_reference[k];
+      run["against_reference"] = {{"reference", input.reference},
+                                  {"mean_translation", scene_by_scene_json(row.translation)},
+                                  {"mean_rotation", scene_by_scene_json(row.rotation)}};
+    }
     if (with_poses) run["poses"] = poses_json(r);
     runs.push_back(run);
   }
@@ -111,20 +118,26 @@ std::string escape_html(const std::string& text) {
 // The speed–accuracy table, readable without JavaScript.
 std::string table_html(const ReportInput& input) {
   std::string rows;
-  for (const bullet::RunResult& r : input.results) {
+  for (size_t k = 0; k < input.results.size(); ++k) {
+    const bullet::RunResult& r = input.results[k];
+    const bool compared = k < input.against_reference.size() && input.against_reference[k];
     rows += fmt::format(
         "<tr><td>{}</td><td>{}</td><td>{:.2f}</td><td>{:.1f}</td><td>{:.4f}</td><td>{:.4f}</td>"
-        "<td>{:.2f}</td><td>{:.2f}</td></tr>\n",
+        "<td>{:.2f}</td><td>{:.2f}</td><td>{}</td><td>{}</td></tr>\n",
         escape_html(r.run.name), escape_html(r.run.kind), r.milliseconds_per_simulated_second,
         1000.0 / r.milliseconds_per_simulated_second, r.mean_translation, r.final_translation,
-        r.mean_rotation, r.final_rotation);
+        r.mean_rotation, r.final_rotation,
+        compared ? scene_by_scene_cell(input.against_reference[k]->translation) : "",
+        compared ? scene_by_scene_cell(input.against_reference[k]->rotation) : "");
   }
   return fmt::format(
       "<table id=\"figures\"><thead><tr><th>run</th><th>kind</th><th>ms per simulated s</th>"
       "<th>× real time</th><th>translation mean (m)</th><th>translation last (m)</th>"
-      "<th>rotation mean (°)</th><th>rotation last (°)</th></tr></thead>\n<tbody>\n{}</tbody>"
-      "</table>\n",
-      rows);
+      "<th>rotation mean (°)</th><th>rotation last (°)</th><th>translation against {ref}, scene "
+      "by scene</th><th>rotation against {ref}, scene by scene</th></tr></thead>\n<tbody>\n{rows}"
+      "</tbody></table>\n<p class=\"note\">{legend}</p>\n",
+      fmt::arg("ref", escape_html(input.reference)), fmt::arg("rows", rows),
+      fmt::arg("legend", escape_html(scene_by_scene_legend())));
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fignet/bullet/comparison.h"
+#include "scene_by_scene.h"
 
 namespace fignet::cli {
 
@@ -13,6 +14,10 @@ struct ReportInput {
   std::string data;  // where the scenes came from
   const std::vector<bullet::SceneSpec>& scenes;
   const std::vector<bullet::RunResult>& results;
+  // Each run against the reference run, scene by scene (index-aligned with results; none for the
+  // ground truth and the reference itself).
+  std::string reference;
+  std::vector<std::optional<SceneBySceneRow>> against_reference;
 };
 
 // Figures, per-frame errors, meshes and every run's poses, numbers rounded for size.

@@ -74,7 +74,7 @@ std::vector<ComparisonRun> standard_runs(const std::vector<std::shared_ptr<const
   }
   SolverSettings coarse;
   coarse.steps_per_frame = 1;
-  runs.push_back({"Bullet 48 Hz", "Bullet", coarse, nullptr, 0.0, {}});
+  runs.push_back({kCoarseBulletRun, "Bullet", coarse, nullptr, 0.0, {}});
   SolverSettings few_iterations;
   few_iterations.iterations = 2;
   runs.push_back({"Bullet 240 Hz, 2 iterations", "Bullet", few_iterations, nullptr, 0.0, {}});

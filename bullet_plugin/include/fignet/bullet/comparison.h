@@ -29,6 +29,10 @@ struct ComparisonRun {
   FIGNetWorldOptions world_options;    // for model runs
 };
 
+// The name of Bullet stepped once per frame, the model's own step: the cheap native setting a
+// learned simulator is set against.
+inline constexpr const char* kCoarseBulletRun = "Bullet 48 Hz";
+
 // Ground truth first, then one run per model, Bullet at 48 Hz, Bullet at 240 Hz with 2 solver
 // iterations, and the chaos floor. `model_names` label the models (file names).
 std::vector<ComparisonRun> standard_runs(const std::vector<std::shared_ptr<const Model>>& models,

@@ -1,0 +1,67 @@
+#include "scene_by_scene.h"
+
+#include <fmt/format.h>
+
+#include "fignet/error.h"
+
+namespace fignet::cli {
+
+namespace {
+
+std::vector<double> field_of(const std::vector<RolloutErrors>& errors,
+                             double RolloutErrors::*field) {
+  std::vector<double> values;
+  values.reserve(errors.size());
+  for (const RolloutErrors& e : errors) values.push_back(e.*field);
+  return values;
+}
+
+}  // namespace
+
+SceneBySceneRow compare_scene_by_scene(const std::vector<RolloutErrors>& reference,
+                                       const std::vector<RolloutErrors>& run,
+                                       const std::string& reference_name,
+                                       const std::string& run_name) {
+  SceneBySceneRow row;
+  PairedComparisonOptions options;
+  options.a_name = reference_name;
+  options.b_name = run_name;
+  try {
+    row.translation = compare_paired(field_of(reference, &RolloutErrors::mean_translation),
+                                     field_of(run, &RolloutErrors::mean_translation), options);
+    row.rotation = compare_paired(field_of(reference, &RolloutErrors::mean_rotation),
+                                  field_of(run, &RolloutErrors::mean_rotation), options);
+  } catch (const ConfigError& e) {
+    row = {std::nullopt, std::nullopt, e.what()};
+  }
+  return row;
+}
+
+std::string scene_by_scene_cell(const std::optional<PairedComparison>& c) {
+  if (!c) return "-";
+  return fmt::format("{:+.1f}% [{:+.1f}, {:+.1f}] {}/{} p={:.2g}", 100 * c->relative,
+                     100 * c->relative_low, 100 * c->relative_high, c->b_lower,
+                     c->b_lower + c->a_lower, c->sign_test_p);
+}
+
+std::string scene_by_scene_legend() {
+  const PairedComparisonOptions options;
+  return fmt::format(
+      "per cent: the run's mean error over the reference's, minus one; [..]: {:.0f} % interval of "
+      "it over {} bootstrap resamples of the scenes (each drawn with both runs' errors); k/n: "
+      "the scenes where the run's error is the lower, of those not tied; p: two-sided sign test "
+      "of that count. An interval that holds 0 does not tell the two apart on these scenes.",
+      100 * options.confidence, options.resamples);
+}
+
+nlohmann::json scene_by_scene_json(const std::optional<PairedComparison>& c) {
+  if (!c) return nullptr;
+  return {{"relative", c->relative},
+          {"relative_low_95", c->relative_low},
+          {"relative_high_95", c->relative_high},
+          {"lower_scenes", c->b_lower},
+          {"higher_scenes", c->a_lower},
+          {"sign_test_p", c->sign_test_p}};
+}
+
+}  // namespace fignet::cli

@@ -1,0 +1,35 @@
+// Two runs over the same scenes set against each other scene by scene, as `fignet eval` sets each
+// model against the first and `fignet compare` each run against Bullet at the model's step.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fignet/rollout/metrics.h"
+#include "fignet/rollout/paired_comparison.h"
+
+namespace fignet::cli {
+
+// A run against the reference on mean translation and rotation. A run whose rollouts left the
+// finite numbers (or a reference with no error at all) has no comparison: `why_not` says why.
+struct SceneBySceneRow {
+  std::optional<PairedComparison> translation, rotation;
+  std::string why_not;
+};
+
+// reference[i] and run[i] are the errors of scene i.
+SceneBySceneRow compare_scene_by_scene(const std::vector<RolloutErrors>& reference,
+                                       const std::vector<RolloutErrors>& run,
+                                       const std::string& reference_name,
+                                       const std::string& run_name);
+
+// "+3.1% [-2.0, +8.4] 61/100 p=0.035", or "-" without a comparison.
+std::string scene_by_scene_cell(const std::optional<PairedComparison>& comparison);
+// What the cells mean, for the end of a printed table.
+std::string scene_by_scene_legend();
+nlohmann::json scene_by_scene_json(const std::optional<PairedComparison>& comparison);
+
+}  // namespace fignet::cli
