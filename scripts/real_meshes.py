@@ -14,6 +14,7 @@ Without FILE arguments it uses the meshes of Debian's assimp-testmodels package.
 """
 
 import argparse
+import json
 import os
 import re
 import subprocess
@@ -45,14 +46,22 @@ def run(command):
     return result.stdout, result.stderr
 
 
-def compare_row(text, prefix):
-    """(ms per simulated second, mean translation m, mean rotation deg) of the row starting with
-    `prefix` in `fignet compare`'s table."""
-    for line in text.splitlines():
-        if line.startswith(prefix):
-            numbers = re.findall(r"[-+]?\d+\.\d+", line[len(prefix):])
-            return float(numbers[0]), float(numbers[2]), float(numbers[4])
-    return None
+def compare_runs(json_path):
+    """(world, Bullet 48 Hz, chaos floor) of `fignet compare --json`, each as (ms per simulated
+    second, mean translation m, mean rotation deg); the world is the last FIGNet run (the world as
+    users get it, after the network alone)."""
+    with open(json_path) as f:
+        runs = json.load(f)["runs"]
+
+    def figures(run):
+        if run is None:
+            return None
+        return (run["ms_per_simulated_second"], run["mean_translation_m"], run["mean_rotation_deg"])
+
+    fignet_runs = [r for r in runs if r["kind"] == "FIGNet"]
+    return (figures(fignet_runs[-1] if fignet_runs else None),
+            figures(next((r for r in runs if r["name"] == "Bullet 48 Hz"), None)),
+            figures(next((r for r in runs if r["kind"] == "chaos floor"), None)))
 
 
 def one_body_step(model, trajectory, frames=24):
@@ -113,14 +122,11 @@ def main():
         trajectories = fignet.read_trajectories(data)
         data_vertices = trajectories[0].vertices(0).shape[0]
         nodes, ms = one_body_step(model, trajectories[0])
+        results = os.path.join(args.work, "compare.json")
         out, _ = run([args.fignet, "compare", "--model", args.model, "--data", data,
                       "--max-scenes", str(args.scenes), "--report",
-                      os.path.join(args.work, "report.html")])
-        # The last FIGNet row is the world as users get it (guards, free flight).
-        rows = [l for l in (out or "").splitlines() if l.startswith("FIGNet ")]
-        world = compare_row(rows[-1], "FIGNet ") if rows else None
-        bullet = compare_row(out or "", "Bullet 48 Hz")
-        chaos = compare_row(out or "", "Bullet 240 Hz, start moved")
+                      os.path.join(args.work, "report.html"), "--json", results])
+        world, bullet, chaos = compare_runs(results) if out is not None else (None, None, None)
         cell = lambda r: f"{r[1]:.2f} / {r[2]:.0f}" if r else "-"
         floor = f"{chaos[1]:.2f}" if chaos else "-"
         print(f"| {name} | {needed} | {data_vertices} / {nodes} | {ms:.2f} | {cell(world)} "
