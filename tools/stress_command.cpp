@@ -135,7 +135,7 @@ void run_stress(const StressArgs& args) {
         "Each case is one scene run by native Bullet at 240 Hz (5 steps per 48 Hz frame) and by "
         "`FIGNetDynamicsWorld` with each model (one step per frame), twice: the network alone "
         "(`FIGNetWorldOptions::network_alone()`, what `fignet eval` measures) and the world as "
-        "users get it (free flight, sleeping, the penetration and the rest guard: "
+        "users get it (free flight, sleeping, the penetration, rest and energy guards: "
         "docs/bullet-world.md; the bodies of these scenes never sleep, since the harness "
         "records every body at every frame). "
         "Cases and metrics: "

@@ -66,7 +66,7 @@ std::vector<ComparisonRun> standard_runs(const std::vector<std::shared_ptr<const
     SolverSettings one_step_per_frame;
     one_step_per_frame.steps_per_frame = 1;
     // The network alone (the model's own accuracy), then the world as users get it (free
-    // flight, sleeping, the penetration and the rest guard).
+    // flight, sleeping, the penetration, rest and energy guards).
     runs.push_back({fmt::format("FIGNet {}, network alone", model_names[i]), "FIGNet",
                     one_step_per_frame, models[i], 0.0, FIGNetWorldOptions::network_alone()});
     runs.push_back({fmt::format("FIGNet {}", model_names[i]), "FIGNet", one_step_per_frame,

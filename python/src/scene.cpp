@@ -30,7 +30,7 @@ class PyScene {
  public:
   PyScene(std::shared_ptr<Model> model, bool free_flight, bool sleeping, bool penetration_guard,
           bool sweep_guard, int threads, std::optional<int> graph_vertices, bool rest_guard,
-          int turns)
+          int turns, bool energy_guard)
       : model_(std::move(model)) {
     // Checked now: the world, and with it the predictor, is made at the first step.
     PredictionOptions{.turns = turns}.validate();
@@ -40,6 +40,7 @@ class PyScene {
     options_.penetration_guard = penetration_guard;
     options_.sweep_guard = sweep_guard;
     options_.rest_guard = rest_guard;
+    options_.energy_guard = energy_guard;
     options_.threads = threads;
     options_.turns = turns;
     if (model_) {
@@ -125,6 +126,7 @@ class PyScene {
     out["mesh_nodes"] = s.mesh_nodes;
     out["guarded_bodies"] = s.guarded_bodies;
     out["recovered_bodies"] = s.recovered_bodies;
+    out["energy_bodies"] = s.energy_bodies;
     out["rested_bodies"] = s.rested_bodies;
     out["prepare_seconds"] = s.prepare_seconds;
     out["predict_seconds"] = s.predict_seconds;
@@ -256,20 +258,21 @@ void bind_scene(py::module_& m) {
 With a model, each frame is one learned step at the model's time step (1/48 s for MOVi-A):
 bodies with nothing within the collision radius fly exactly under gravity (free_flight), resting
 islands sleep as in Bullet (sleeping), and bodies that sink into the floor or other static bodies
-are pushed out (penetration_guard), and bodies that stand at rest stay where they are, by
-Coulomb's static friction under gravity (rest_guard); turn all four off for the network alone, as
-`fignet eval` measures it. A mesh finer than the model was trained on enters the graph simplified to
+are pushed out (penetration_guard), bodies that stand at rest stay where they are, by
+Coulomb's static friction under gravity (rest_guard), and islands in contact do not gain
+mechanical energy beyond a tenth of their kinetic energy (energy_guard); turn all five off for
+the network alone, as `fignet eval` measures it. A mesh finer than the model was trained on enters the graph simplified to
 `graph_vertices` (default None: the model's own resolution, 64 for MOVi-A; 0: never) within 2 %
 of its size; Bullet still collides the full mesh. `turns` > 1 predicts each frame that
 many times, the scene turned by k/turns of a turn about the vertical, and averages: it cancels the
 sideways push a model gives resting bodies, at `turns` times the cost. Without a model, native Bullet steps at 240 Hz,
 5 substeps per frame.)")
       .def(py::init<std::shared_ptr<Model>, bool, bool, bool, bool, int, std::optional<int>, bool,
-                    int>(),
+                    int, bool>(),
            py::arg("model") = py::none(), py::arg("free_flight") = true, py::arg("sleeping") = true,
            py::arg("penetration_guard") = true, py::arg("sweep_guard") = true,
            py::arg("threads") = 1, py::arg("graph_vertices") = py::none(),
-           py::arg("rest_guard") = true, py::arg("turns") = 1)
+           py::arg("rest_guard") = true, py::arg("turns") = 1, py::arg("energy_guard") = true)
       .def(
           "add_body",
           [](PyScene& scene, const py::handle& vertices, const py::handle& faces,

@@ -63,6 +63,14 @@ struct FIGNetWorldOptions {
   // takes over. false: the model moves resting bodies.
   bool rest_guard = true;
   double rest_contact_distance = 0.005;  // metres
+  // The energy guard: contact between passive rigid bodies only takes mechanical energy away
+  // (restitution at most 1, friction), so an island of bodies the network moved whose step
+  // gains kinetic plus potential energy beyond energy_tolerance of its kinetic energy (and a
+  // millimetre's lift per body) has its bodies' steps shortened, all by one factor, until it does
+  // not. A model outside its data (shapes, speeds, materials) otherwise throws bodies about.
+  // Islands touched by a kinematic body or a force other than gravity are left alone.
+  bool energy_guard = true;
+  double energy_tolerance = 0.1;  // fraction of the island's kinetic energy before the step
   // The node budget: a body's mesh with more vertices than this is simplified (meshoptimizer,
   // once per shape) within simplify_tolerance of its largest side before it enters the graph, so
   // a 20,000-vertex mesh costs about what the model's own meshes cost; the tolerance keeps the
@@ -78,13 +86,14 @@ struct FIGNetWorldOptions {
   double simplify_tolerance = 0.02;
 
   // The network alone on every awake body, as `fignet eval` rolls out and the paper measures: no
-  // free flight, no sleeping, no penetration or rest guard (the sweep guard is kept).
+  // free flight, no sleeping, no penetration, rest or energy guard (the sweep guard is kept).
   static FIGNetWorldOptions network_alone() {
     FIGNetWorldOptions options;
     options.free_flight = false;
     options.sleeping = false;
     options.penetration_guard = false;
     options.rest_guard = false;
+    options.energy_guard = false;
     return options;
   }
   // Threads for the network's matrix products (see PredictionOptions; 0: every core). One keeps
@@ -111,6 +120,7 @@ struct FIGNetStepStats {
   int guarded_bodies = 0;      // bodies stopped by the tunnelling guard
   int recovered_bodies = 0;    // bodies moved out of static geometry by the penetration guard
   int rested_bodies = 0;       // awake bodies the rest guard kept still, without the network
+  int energy_bodies = 0;       // bodies whose steps the energy guard shortened
   // Simulated bodies whose friction or restitution lie outside the model's training data's
   // (ModelConfig::friction, restitution), and whether the floor in contact range does: there
   // the model guesses. Always 0 and false for a model that does not record its data's materials.
