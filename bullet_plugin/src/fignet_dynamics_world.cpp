@@ -631,11 +631,9 @@ struct FIGNetDynamicsWorld::Impl {
     }
   }
 
-  // Mechanical energy of a body over one step from `from` to `to`: kinetic (linear and
-  // rotational, by the finite-difference velocities the network reads) plus potential at `to`.
-  double step_energy(const btRigidBody& body, const Pose& from, const Pose& to) const {
-    if (body.getInvMass() == 0) return 0.0;
-    const double mass = 1.0 / body.getInvMass();
+  // Kinetic energy of a body over one step from `from` to `to`, linear and rotational, by the
+  // finite-difference velocities the network reads.
+  double kinetic_energy(const btRigidBody& body, const Pose& from, const Pose& to) const {
     const Vec3 linear = (to.position - from.position) / time_step;
     const Eigen::AngleAxisd turn(to.orientation * from.orientation.conjugate());
     const Vec3 angular = turn.axis() * (turn.angle() / time_step);
@@ -646,40 +644,36 @@ struct FIGNetDynamicsWorld::Impl {
     for (int k = 0; k < 3; ++k) {
       if (inverse[k] > 0) rotational += local[k] * local[k] / inverse[k];
     }
-    return 0.5 * mass * linear.squaredNorm() + 0.5 * rotational -
-           mass * from_bt(body.getGravity()).dot(to.position);
+    return 0.5 * linear.squaredNorm() / body.getInvMass() + 0.5 * rotational;
   }
 
-  // The energy guard (options.energy_guard). Per island of the bodies the network moved: E
-  // before (last step's velocities, current poses) and after (the predicted step); an island
-  // that gains more than its allowance has every member's step scaled by one factor s, the
-  // largest for which K·s² + W·s ≤ B (K the predicted kinetic energy, W the potential energy the
-  // whole step adds, B what the allowance leaves above the current potential energy).
-  void guard_energy(const btDiscreteDynamicsWorld& world) {
+  // The energy guard (options.energy_guard). Per island of the bodies the network moved: the
+  // kinetic energy before (last step's velocities) and after (the predicted step) and the
+  // potential energy the step adds; an island that gains more than its allowance has every
+  // member's step scaled by one factor s, the largest for which K·s² + W·s ≤ B (K the predicted
+  // kinetic energy, W the potential energy the whole step adds, B the kinetic energy before plus
+  // the allowance).
+  void guard_energy() {
     if (!options.energy_guard || networked.empty()) return;
     struct Island {
-      double before = 0, kinetic = 0, added_potential = 0, current_potential = 0, lift = 0;
+      double kinetic_before = 0, kinetic_after = 0, added_potential = 0, lift = 0;
       bool driven = false;
       std::vector<size_t> members;
     };
     std::unordered_map<int, Island> islands;
-    const double g = from_bt(world.getGravity()).norm();
     for (const int i : networked) {
       btRigidBody& body = *moving[static_cast<size_t>(i)];
       if (body.getInvMass() == 0) continue;
       Island& island = islands[find(dynamic_index.at(&body))];
       const std::vector<Pose>& poses = states.at(&body).poses;
       const Pose& current = poses.back();
-      const Pose& previous = poses[poses.size() - 2];
+      const Pose& next_pose = next[static_cast<size_t>(i)];
       const double mass = 1.0 / body.getInvMass();
       const Vec3 gravity = from_bt(body.getGravity());
-      const double potential_now = -mass * gravity.dot(current.position);
-      const double potential_next = -mass * gravity.dot(next[static_cast<size_t>(i)].position);
-      island.before += step_energy(body, previous, current);
-      island.kinetic += step_energy(body, current, next[static_cast<size_t>(i)]) - potential_next;
-      island.added_potential += potential_next - potential_now;
-      island.current_potential += potential_now;
-      island.lift += mass * g * 1e-3;
+      island.kinetic_before += kinetic_energy(body, poses[poses.size() - 2], current);
+      island.kinetic_after += kinetic_energy(body, current, next_pose);
+      island.added_potential -= mass * gravity.dot(next_pose.position - current.position);
+      island.lift += mass * gravity.norm() * 1e-3;
       island.driven = island.driven || pushed.count(&body) > 0;
       island.members.push_back(static_cast<size_t>(i));
     }
@@ -692,15 +686,12 @@ struct FIGNetDynamicsWorld::Impl {
       }
     }
     for (auto& [root, island] : islands) {
-      if (island.driven || island.kinetic <= 0) continue;
-      const double kinetic_before = island.before - island.current_potential;
-      const double budget =
-          kinetic_before + options.energy_tolerance * std::max(0.0, kinetic_before) + island.lift;
-      const double K = island.kinetic, W = island.added_potential;
+      if (island.driven || island.kinetic_after <= 0) continue;
+      const double budget = (1 + options.energy_tolerance) * island.kinetic_before + island.lift;
+      const double K = island.kinetic_after, W = island.added_potential;
       if (K + W <= budget) continue;
-      const double s = std::clamp(
-          (-W + std::sqrt(std::max(0.0, W * W + 4 * K * std::max(0.0, budget)))) / (2 * K), 0.0,
-          1.0);
+      // K > 0 and budget ≥ 0: the root is real and at least 0.
+      const double s = std::min(1.0, (-W + std::sqrt(W * W + 4 * K * budget)) / (2 * K));
       for (const size_t i : island.members) {
         const Pose& current = states.at(moving[i]).poses.back();
         next[i].position = current.position + s * (next[i].position - current.position);
@@ -1263,7 +1254,7 @@ void FIGNetDynamicsWorld::internalSingleStepSimulation(btScalar time_step) {
   const auto predict_start = Clock::now();
   impl.advance();
   impl.guard_fast_bodies(*this);
-  impl.guard_energy(*this);
+  impl.guard_energy();
   impl.stats.predict_seconds = seconds_since(predict_start);
 
   const auto write_start = Clock::now();
