@@ -67,19 +67,14 @@ std::vector<std::optional<SceneBySceneRow>> against_coarse_bullet(
 
 void print_against(const std::vector<bullet::RunResult>& results, const std::string& reference,
                    const std::vector<std::optional<SceneBySceneRow>>& rows) {
-  if (std::none_of(rows.begin(), rows.end(), [](const auto& row) { return row.has_value(); })) {
-    return;
-  }
-  fmt::print("\nagainst {}, scene by scene\n", reference);
-  fmt::print("{:<48} {:>38} {:>38}\n", "run", "mean translation", "mean rotation");
+  std::vector<std::string> labels;
+  std::vector<const SceneBySceneRow*> lines;
   for (size_t k = 0; k < rows.size(); ++k) {
     if (!rows[k]) continue;
-    fmt::print("{:<48} {:>38} {:>38}{}\n",
-               fmt::format("{} ({})", results[k].run.name, results[k].run.kind),
-               scene_by_scene_cell(rows[k]->translation), scene_by_scene_cell(rows[k]->rotation),
-               rows[k]->why_not.empty() ? "" : "  " + rows[k]->why_not);
+    labels.push_back(fmt::format("{} ({})", results[k].run.name, results[k].run.kind));
+    lines.push_back(&*rows[k]);
   }
-  fmt::print("\n{}\n", scene_by_scene_legend());
+  if (!lines.empty()) print_scene_by_scene(reference, labels, lines, 48);
 }
 
 void run_compare(const CompareArgs& args) {

@@ -190,15 +190,14 @@ SceneBySceneRow paired_against(const Row& reference, const Row& row) {
 
 // paired[k] is rows[k + 1] against rows[0].
 void print_paired(const std::vector<Row>& rows, const std::vector<SceneBySceneRow>& paired) {
-  fmt::print("\nagainst {} ({}), scene by scene\n", rows.front().name, rows.front().kind);
-  fmt::print("{:<34} {:>38} {:>38}\n", "run", "mean translation", "mean rotation");
+  std::vector<std::string> labels;
+  std::vector<const SceneBySceneRow*> lines;
   for (size_t k = 0; k < paired.size(); ++k) {
-    const Row& row = rows[k + 1];
-    fmt::print("{:<34} {:>38} {:>38}{}\n", fmt::format("{} ({})", row.name, row.kind),
-               scene_by_scene_cell(paired[k].translation), scene_by_scene_cell(paired[k].rotation),
-               paired[k].why_not.empty() ? "" : "  " + paired[k].why_not);
+    labels.push_back(fmt::format("{} ({})", rows[k + 1].name, rows[k + 1].kind));
+    lines.push_back(&paired[k]);
   }
-  fmt::print("\n{}\n", scene_by_scene_legend());
+  print_scene_by_scene(fmt::format("{} ({})", rows.front().name, rows.front().kind), labels, lines,
+                       34);
 }
 
 nlohmann::json to_json(const Row& row) {
@@ -308,9 +307,7 @@ void run_eval(const EvalArgs& args) {
       out["runs"].push_back(to_json(rows[k]));
       // Against the first run, scene by scene (absent from the first run itself).
       if (k > 0) {
-        out["runs"].back()["paired_against_first"] = {
-            {"mean_translation", scene_by_scene_json(paired[k - 1].translation)},
-            {"mean_rotation", scene_by_scene_json(paired[k - 1].rotation)}};
+        out["runs"].back()["paired_against_first"] = scene_by_scene_json(paired[k - 1]);
       }
     }
     write_text_atomically(args.json, out.dump(2) + "\n");

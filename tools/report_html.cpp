@@ -73,10 +73,8 @@ nlohmann::json report_json(const ReportInput& input, bool with_poses) {
                           {"rotation_per_frame_deg", rounded_list(r.rotation)}};
     const size_t k = runs.size();
     if (k < input.against_reference.size() && input.against_reference[k]) {
-      const SceneBySceneRow& row = *input.against_reference[k];
-      run["against_reference"] = {{"reference", input.reference},
-                                  {"mean_translation", scene_by_scene_json(row.translation)},
-                                  {"mean_rotation", scene_by_scene_json(row.rotation)}};
+      run["against_reference"] = scene_by_scene_json(*input.against_reference[k]);
+      run["against_reference"]["reference"] = input.reference;
     }
     if (with_poses) run["poses"] = poses_json(r);
     runs.push_back(run);

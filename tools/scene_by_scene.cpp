@@ -64,4 +64,21 @@ nlohmann::json scene_by_scene_json(const std::optional<PairedComparison>& c) {
           {"sign_test_p", c->sign_test_p}};
 }
 
+nlohmann::json scene_by_scene_json(const SceneBySceneRow& row) {
+  return {{"mean_translation", scene_by_scene_json(row.translation)},
+          {"mean_rotation", scene_by_scene_json(row.rotation)}};
+}
+
+void print_scene_by_scene(const std::string& reference, const std::vector<std::string>& labels,
+                          const std::vector<const SceneBySceneRow*>& rows, int label_width) {
+  fmt::print("\nagainst {}, scene by scene\n", reference);
+  fmt::print("{:<{}} {:>38} {:>38}\n", "run", label_width, "mean translation", "mean rotation");
+  for (size_t k = 0; k < rows.size(); ++k) {
+    fmt::print("{:<{}} {:>38} {:>38}{}\n", labels[k], label_width,
+               scene_by_scene_cell(rows[k]->translation), scene_by_scene_cell(rows[k]->rotation),
+               rows[k]->why_not.empty() ? "" : "  " + rows[k]->why_not);
+  }
+  fmt::print("\n{}\n", scene_by_scene_legend());
+}
+
 }  // namespace fignet::cli

@@ -31,5 +31,12 @@ std::string scene_by_scene_cell(const std::optional<PairedComparison>& compariso
 // What the cells mean, for the end of a printed table.
 std::string scene_by_scene_legend();
 nlohmann::json scene_by_scene_json(const std::optional<PairedComparison>& comparison);
+// {"mean_translation": ..., "mean_rotation": ...} of a row.
+nlohmann::json scene_by_scene_json(const SceneBySceneRow& row);
+
+// The section a command prints: "against REFERENCE, scene by scene", one line per labelled row
+// (labels padded to label_width), then the legend.
+void print_scene_by_scene(const std::string& reference, const std::vector<std::string>& labels,
+                          const std::vector<const SceneBySceneRow*>& rows, int label_width);
 
 }  // namespace fignet::cli
