@@ -2,6 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <string>
+#include <vector>
+
 #include "fignet/error.h"
 
 namespace fignet::cli {
@@ -71,12 +75,22 @@ nlohmann::json scene_by_scene_json(const SceneBySceneRow& row) {
 
 void print_scene_by_scene(const std::string& reference, const std::vector<std::string>& labels,
                           const std::vector<const SceneBySceneRow*>& rows, int label_width) {
+  // Columns as wide as their widest entry, so long labels and tiny p-values keep them aligned.
+  std::vector<std::string> translation, rotation;
+  size_t cell_width = 38;
+  for (const SceneBySceneRow* row : rows) {
+    translation.push_back(scene_by_scene_cell(row->translation));
+    rotation.push_back(scene_by_scene_cell(row->rotation));
+    cell_width = std::max({cell_width, translation.back().size(), rotation.back().size()});
+  }
+  size_t label_columns = static_cast<size_t>(std::max(label_width, 3));
+  for (const std::string& label : labels) label_columns = std::max(label_columns, label.size());
   fmt::print("\nagainst {}, scene by scene\n", reference);
-  fmt::print("{:<{}} {:>38} {:>38}\n", "run", label_width, "mean translation", "mean rotation");
+  fmt::print("{:<{}} {:>{}} {:>{}}\n", "run", label_columns, "mean translation", cell_width,
+             "mean rotation", cell_width);
   for (size_t k = 0; k < rows.size(); ++k) {
-    fmt::print("{:<{}} {:>38} {:>38}{}\n", labels[k], label_width,
-               scene_by_scene_cell(rows[k]->translation), scene_by_scene_cell(rows[k]->rotation),
-               rows[k]->why_not.empty() ? "" : "  " + rows[k]->why_not);
+    fmt::print("{:<{}} {:>{}} {:>{}}{}\n", labels[k], label_columns, translation[k], cell_width,
+               rotation[k], cell_width, rows[k]->why_not.empty() ? "" : "  " + rows[k]->why_not);
   }
   fmt::print("\n{}\n", scene_by_scene_legend());
 }
