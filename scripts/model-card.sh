@@ -3,7 +3,11 @@
 #   scripts/model-card.sh MODEL.h5 [OUT_DIR]
 # into OUT_DIR (default out/card/NAME/):
 #   test-turns1.txt, eval.json  fignet eval on the test split (rollouts, regime split, ballistic)
-#   test-turns2.txt             the same with each prediction averaged over a half turn
+#   test-turns2.txt, eval-turns2.json
+#                               the same with each prediction averaged over a half turn
+#   test-turns4.txt, eval-turns4.json
+#                               and over quarter turns (4 predictions a step; the JSONs' per-
+#                               trajectory errors pair the three scene by scene)
 #   compare.txt, report.html    fignet compare on scripts/demo.sh's 4 scenes, next to native Bullet
 #   stress.md, stress.txt       fignet stress, every case, network alone and the world
 #   rest-turns2.txt             the resting cubes and the stacks again with 2 turns
@@ -33,7 +37,9 @@ rollouts() {
   "$fignet" eval --model "$model" --data "$test_split" --json "$out/eval.json" \
     >"$out/test-turns1.txt" 2>&1
   "$fignet" eval --model "$model" --data "$test_split" --turns 2 --no-baseline \
-    >"$out/test-turns2.txt" 2>&1
+    --json "$out/eval-turns2.json" >"$out/test-turns2.txt" 2>&1
+  "$fignet" eval --model "$model" --data "$test_split" --turns 4 --no-baseline --no-penetration \
+    --no-regimes --json "$out/eval-turns4.json" >"$out/test-turns4.txt" 2>&1
 }
 side_by_side() {
   "$fignet" compare --model "$model" --data "$scenes" --max-scenes 4 \
@@ -68,5 +74,5 @@ if [[ -f "$log" ]]; then
   fi
   "$python" scripts/training-log.py --fit --fit-from 100k "${plot[@]}" "$log" >"$out/curve.md"
 fi
-grep -h -E "\) +[0-9.]+ +[0-9.]+ +[0-9.]+" "$out/test-turns1.txt" "$out/test-turns2.txt" || true
+grep -h -E "\) +[0-9.]+ +[0-9.]+ +[0-9.]+" "$out"/test-turns{1,2,4}.txt || true
 echo "figures in $out/"

@@ -338,3 +338,43 @@ def test_side_by_side_puts_runs_next_to_each_other_at_shared_samples(source_dir,
                            "4.0, 8.0, — / 2.0, 4.0, —", "1.50 / —"]
     assert rows[1][1:3] == ["**1.000** / 1.100", "+10.0 %"]
     assert rows[1][3] == "+0.2 / +0.3"
+
+
+def write_eval(path, data, name, translations, rotation=30.0):
+    """A `fignet eval --json` result with one FIGNet run and the ballistic baseline."""
+    per_trajectory = [{"mean_translation_m": t, "mean_rotation_deg": rotation}
+                      for t in translations]
+    runs = [{"name": name, "kind": "FIGNet", "per_trajectory": per_trajectory},
+            {"name": "ballistic", "kind": "constant velocity + gravity",
+             "per_trajectory": per_trajectory}]
+    path.write_text(json.dumps({"data": [data], "trajectories": len(translations), "runs": runs}))
+
+
+def run_paired_evals(source_dir, *args):
+    return subprocess.run([sys.executable, str(source_dir / "scripts" / "paired-evals.py"),
+                           *map(str, args)], capture_output=True, text=True)
+
+
+def test_paired_evals_compares_scene_by_scene(source_dir, tmp_path):
+    # Every scene halved: -50 % with a degenerate interval, lower on all 6, sign test 2/64; the
+    # rotations are tied everywhere, so no scene counts either way.
+    write_eval(tmp_path / "a.json", "test.h5", "A.h5", [1.0, 2.0, 0.5, 3.0, 1.5, 0.25])
+    write_eval(tmp_path / "b.json", "test.h5", "B.h5", [0.5, 1.0, 0.25, 1.5, 0.75, 0.125])
+    result = run_paired_evals(source_dir, tmp_path / "a.json", tmp_path / "b.json")
+    assert result.returncode == 0, result.stderr
+    translation = [line for line in result.stdout.splitlines() if line.startswith("mean trans")]
+    assert len(translation) == 1, result.stdout
+    assert "-50.0% [-50.0, -50.0]  lower on 6/6  p=0.031" in translation[0]
+    assert "+0.0% [+0.0, +0.0]  lower on 0/0  p=1" in result.stdout
+
+
+def test_paired_evals_names_what_does_not_match(source_dir, tmp_path):
+    write_eval(tmp_path / "a.json", "test.h5", "A.h5", [1.0, 2.0])
+    write_eval(tmp_path / "b.json", "other.h5", "B.h5", [1.0, 2.0])
+    result = run_paired_evals(source_dir, tmp_path / "a.json", tmp_path / "b.json")
+    assert result.returncode == 1 and "different scenes" in result.stderr
+    result = run_paired_evals(source_dir, tmp_path / "a.json", tmp_path / "a.json", "--run", "C.h5")
+    assert result.returncode == 1
+    assert "has no run 'C.h5' (its runs: A.h5, ballistic)" in result.stderr
+    result = run_paired_evals(source_dir, tmp_path / "a.json", tmp_path / "missing.json")
+    assert result.returncode == 1 and "cannot read" in result.stderr and "missing.json" in result.stderr
