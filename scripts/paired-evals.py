@@ -8,17 +8,16 @@ Each side is one run of its file (default: its first FIGNet run; --run / --refer
 by name). Both files must hold the same data and trajectories. Prints, for the mean translation
 and the mean rotation over each rollout: the two means, the run's mean over the reference's minus
 one with a 95 % interval over 10,000 bootstrap resamples of the scenes (fixed seed: the same
-interval every time), the scenes where the run is the lower, and the two-sided sign test.
+interval every time), the scenes where the run is the lower, and the two-sided sign test: the
+library's own comparison (`fignet.compare_paired`), so the figures are those `fignet eval` prints
+for models of one run. Needs the Python module (PYTHONPATH=build/release/python).
 """
 
 import argparse
 import json
-import math
-import random
 import sys
 
-RESAMPLES = 10000
-CONFIDENCE = 0.95
+import fignet
 
 
 def fail(message):
@@ -50,33 +49,6 @@ def load_run(path, name):
     return result.get("data"), per_trajectory
 
 
-def sign_test_p(lower, higher):
-    """Two-sided binomial test of `lower` successes in lower + higher fair draws."""
-    n = lower + higher
-    if n == 0:
-        return 1.0
-    k = min(lower, higher)
-    tail = sum(math.comb(n, i) for i in range(k + 1)) / 2.0**n
-    return min(1.0, 2.0 * tail)
-
-
-def compare(reference, run, rng):
-    """Relative difference of the means, its bootstrap interval, and the sign count."""
-    n = len(reference)
-    relative = sum(run) / sum(reference) - 1.0
-    draws = []
-    for _ in range(RESAMPLES):
-        picks = [rng.randrange(n) for _ in range(n)]
-        draws.append(sum(run[i] for i in picks) / sum(reference[i] for i in picks) - 1.0)
-    draws.sort()
-    tail = (1.0 - CONFIDENCE) / 2.0
-    low = draws[int(tail * RESAMPLES)]
-    high = draws[int((1.0 - tail) * RESAMPLES) - 1]
-    lower = sum(1 for a, b in zip(reference, run) if b < a)
-    higher = sum(1 for a, b in zip(reference, run) if b > a)
-    return relative, low, high, lower, higher
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("reference")
@@ -91,16 +63,15 @@ def main():
         fail(f"the two results are of different scenes ({reference_data}, {len(reference)} "
              f"trajectories; {run_data}, {len(run)})")
 
-    rng = random.Random(1)
     print(f"{len(run)} scenes of {', '.join(run_data or [])}; {args.run} against {args.reference}")
     for label, field in (("mean translation (m)", "mean_translation_m"),
                          ("mean rotation (deg)", "mean_rotation_deg")):
         a = [trajectory[field] for trajectory in reference]
         b = [trajectory[field] for trajectory in run]
-        relative, low, high, lower, higher = compare(a, b, rng)
-        print(f"{label}: {sum(a) / len(a):.4f} -> {sum(b) / len(b):.4f}  {100 * relative:+.1f}% "
-              f"[{100 * low:+.1f}, {100 * high:+.1f}]  lower on {lower}/{lower + higher}  "
-              f"p={sign_test_p(lower, higher):.2g}")
+        c = fignet.compare_paired(a, b)
+        print(f"{label}: {c['mean_a']:.4f} -> {c['mean_b']:.4f}  {100 * c['relative']:+.1f}% "
+              f"[{100 * c['relative_low']:+.1f}, {100 * c['relative_high']:+.1f}]  "
+              f"lower on {c['b_lower']}/{c['b_lower'] + c['a_lower']}  p={c['sign_test_p']:.2g}")
 
 
 if __name__ == "__main__":
