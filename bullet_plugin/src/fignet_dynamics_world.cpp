@@ -53,13 +53,15 @@ std::optional<Floor> as_floor(const btCollisionObject& object) {
   return Floor{point.z(), {0.0, object.getFriction(), object.getRestitution()}};
 }
 
-// Poses h, h−1, …, 0 steps back from `current`, moving with constant velocities (oldest first).
+// Poses h, h−1, …, 0 steps back from `current`, moving with constant velocities (oldest first),
+// the centre of mass on the parabola of `acceleration` (zero: a straight line) through the
+// current position with the current velocity.
 std::vector<Pose> seed_history(const Pose& current, const Vec3& linear, const Vec3& angular,
-                               int history, double dt) {
+                               int history, double dt, const Vec3& acceleration = Vec3::Zero()) {
   std::vector<Pose> poses(history + 1);
   for (int k = 0; k <= history; ++k) {
     const double tau = (k - history) * dt;  // <= 0
-    poses[k].position = current.position + tau * linear;
+    poses[k].position = current.position + tau * linear + 0.5 * tau * tau * acceleration;
     const Vec3 angle = tau * angular;
     poses[k].orientation =
         angle.norm() > 0
@@ -285,23 +287,60 @@ struct FIGNetDynamicsWorld::Impl {
   }
 
   // The body's state, its history reseeded from its current velocities when it is new, woke up,
-  // or the user moved it or changed its velocity since the last step.
+  // or the user moved it or changed its velocity since the last step. A body reseeded in free
+  // flight (nothing within the collision radius) falls along its gravity's parabola in the
+  // history, as it did in the training data; one that may be supported keeps a straight line
+  // (a parabola would show a resting body as one that was falling onto what holds it).
   BodyState& state_of(btRigidBody& body) {
+    BodyState& state = with_mesh(body);
+    const bool unchanged = state.valid && body.getWorldTransform() == state.written &&
+                           body.getLinearVelocity() == state.written_linear &&
+                           body.getAngularVelocity() == state.written_angular;
+    if (!unchanged) {
+      const Pose current = from_bt(body.getWorldTransform());
+      const Vec3 linear = from_bt(body.getLinearVelocity());
+      const Vec3 angular = from_bt(body.getAngularVelocity());
+      state.poses = seed_history(current, linear, angular, graph.history, time_step);
+      state.valid = true;
+      if (options.seed_falling && in_free_flight(body)) {
+        state.poses = seed_history(current, linear, angular, graph.history, time_step,
+                                   from_bt(body.getGravity()));
+      }
+    }
+    return state;
+  }
+
+  // A dynamic body's state with its mesh and bounding radius, its history not yet set.
+  BodyState& with_mesh(const btCollisionObject& body) {
     BodyState& state = states[&body];
     if (!state.mesh) {
       state.mesh = shapes.mesh_of(*body.getCollisionShape());
       state.radius = state.mesh->vertices().rowwise().norm().maxCoeff();
     }
-    const bool unchanged = state.valid && body.getWorldTransform() == state.written &&
-                           body.getLinearVelocity() == state.written_linear &&
-                           body.getAngularVelocity() == state.written_angular;
-    if (!unchanged) {
-      state.poses =
-          seed_history(from_bt(body.getWorldTransform()), from_bt(body.getLinearVelocity()),
-                       from_bt(body.getAngularVelocity()), graph.history, time_step);
-      state.valid = true;
-    }
     return state;
+  }
+
+  // Whether a body touches nothing within the collision radius, by its broadphase partners: a
+  // floor plane more than the radius below its mesh, a dynamic body whose bounding sphere is
+  // more than the radius from its own (broadphase boxes of large tilted bodies overlap well
+  // before the bodies meet). Other static or kinematic geometry may hold it. Needs this step's
+  // pairs and the body's current pose in its history.
+  bool in_free_flight(const btCollisionObject& body) {
+    const double radius = with_mesh(body).radius;
+    const btVector3 centre = body.getWorldTransform().getOrigin();
+    for (const auto& [a, b] : pairs) {
+      if (a != &body && b != &body) continue;
+      const btCollisionObject& other = a == &body ? *b : *a;
+      if (const std::optional<Floor> floor = as_floor(other)) {
+        if (near_floor(body, *floor)) return false;
+      } else if (is_dynamic(&other)) {
+        const double reach = radius + with_mesh(other).radius + graph.collision_radius;
+        if ((other.getWorldTransform().getOrigin() - centre).length() <= reach) return false;
+      } else {
+        return false;
+      }
+    }
+    return true;
   }
 
   int add_object(const btCollisionObject& owner, const TriangleMesh& mesh,

@@ -23,52 +23,112 @@ using testing::recording_predictor;
 using testing::WorldFixture;
 
 // Free flight, by the world's own path and by an exact-gravity predictor through the network's
-// path: both follow x_{n+1} = 2x_n − x_{n−1} + g·dt² from a constant-velocity history, so
-// x_n = x_0 + n·dt·v0 + n(n+1)/2·g·dt² and v_n = v0 + n·g·dt (Bullet's semi-implicit Euler).
+// path: both follow x_{n+1} = 2x_n − x_{n−1} + g·dt². A body seeded in free flight has the
+// parabola through its start as its history, so it stays on it: x_n = x_0 + n·dt·v0 + n²/2·g·dt²,
+// and its velocity (the last step's) is v0 + (n − ½)·g·dt. Seeded moving straight
+// (seed_falling off) it follows Bullet's semi-implicit Euler instead: x_n = x_0 + n·dt·v0 +
+// n(n+1)/2·g·dt², v_n = v0 + n·g·dt, ½·g·dt² lower at every step.
 TEST(FIGNetWorld, FreeFlightFollowsTheAnalyticTrajectory) {
-  for (const bool free_flight : {true, false}) {
-    SCOPED_TRACE(free_flight ? "free-flight path" : "through the predictor");
-    FIGNetWorldOptions options = FIGNetWorldOptions::network_alone();
-    options.free_flight = free_flight;
-    auto predictor = recording_predictor();
-    const auto* recorder = predictor.get();
-    WorldFixture fixture(std::move(predictor), {}, options);
-    // Without Bullet's one-step latency, motion states show the step's own result.
-    fixture.world.setLatencyMotionStateInterpolation(false);
-    btRigidBody* box = fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.3f, 0.4f)), 2.0,
-                                   at(Vec3(0, 0, 50)));
-    const Vec3 v0(1.0, -2.0, 3.0), w0(0.5, -1.0, 2.0);
-    box->setLinearVelocity(to_bt(v0));
-    box->setAngularVelocity(to_bt(w0));
-    const double dt = WorldFixture::kStep;
-    const Vec3 g(0, 0, -10);
-    double worst_precise = 0;
-    for (int n = 1; n <= 48; ++n) {
-      fixture.step();
-      const Vec3 expected = Vec3(0, 0, 50) + n * dt * v0 + 0.5 * n * (n + 1) * dt * dt * g;
-      const Vec3 position = from_bt(box->getCenterOfMassPosition());
-      ASSERT_LT((position - expected).norm(), 2e-4 * (1 + n)) << "step " << n;
-      worst_precise =
-          std::max(worst_precise, (fixture.world.precise_pose(*box).position - expected).norm());
-      EXPECT_LT((from_bt(box->getLinearVelocity()) - (v0 + n * dt * g)).norm(), 1e-3);
-      btTransform motion;
-      box->getMotionState()->getWorldTransform(motion);
-      EXPECT_LT((motion.getOrigin() - box->getWorldTransform().getOrigin()).length(), 1e-5);
+  for (const bool seed_falling : {true, false}) {
+    for (const bool free_flight : {true, false}) {
+      SCOPED_TRACE(fmt::format("{}, seeded {}",
+                               free_flight ? "free-flight path" : "through the predictor",
+                               seed_falling ? "falling" : "straight"));
+      FIGNetWorldOptions options = FIGNetWorldOptions::network_alone();
+      options.free_flight = free_flight;
+      options.seed_falling = seed_falling;
+      auto predictor = recording_predictor();
+      const auto* recorder = predictor.get();
+      WorldFixture fixture(std::move(predictor), {}, options);
+      // Without Bullet's one-step latency, motion states show the step's own result.
+      fixture.world.setLatencyMotionStateInterpolation(false);
+      btRigidBody* box = fixture.add(std::make_unique<btBoxShape>(btVector3(0.2f, 0.3f, 0.4f)), 2.0,
+                                     at(Vec3(0, 0, 50)));
+      const Vec3 v0(1.0, -2.0, 3.0), w0(0.5, -1.0, 2.0);
+      box->setLinearVelocity(to_bt(v0));
+      box->setAngularVelocity(to_bt(w0));
+      const double dt = WorldFixture::kStep;
+      const Vec3 g(0, 0, -10);
+      double worst_precise = 0;
+      for (int n = 1; n <= 48; ++n) {
+        fixture.step();
+        const double fall = seed_falling ? 0.5 * n * n : 0.5 * n * (n + 1);
+        const Vec3 expected = Vec3(0, 0, 50) + n * dt * v0 + fall * dt * dt * g;
+        const Vec3 position = from_bt(box->getCenterOfMassPosition());
+        ASSERT_LT((position - expected).norm(), 2e-4 * (1 + n)) << "step " << n;
+        worst_precise =
+            std::max(worst_precise, (fixture.world.precise_pose(*box).position - expected).norm());
+        const double speed_steps = seed_falling ? n - 0.5 : n;
+        EXPECT_LT((from_bt(box->getLinearVelocity()) - (v0 + speed_steps * dt * g)).norm(), 1e-3);
+        btTransform motion;
+        box->getMotionState()->getWorldTransform(motion);
+        EXPECT_LT((motion.getOrigin() - box->getWorldTransform().getOrigin()).length(), 1e-5);
+      }
+      // The world's own path is exact in double precision; the predictor's goes through vertex
+      // accelerations and a rigid fit.
+      if (free_flight) {
+        EXPECT_LT(worst_precise, 1e-9);
+        // Constant angular velocity: 48 steps turn the box by 48·dt·|ω| about ω.
+        const Eigen::AngleAxisd turned(fixture.world.precise_pose(*box).orientation);
+        EXPECT_NEAR(turned.angle(), 48 * dt * w0.norm(), 1e-9);
+        EXPECT_LT((turned.axis() - w0.normalized()).norm(), 1e-9);
+        EXPECT_EQ(recorder->calls, 0);
+      }
+      const FIGNetStepStats& stats = fixture.world.last_step_stats();
+      EXPECT_EQ(stats.simulated_bodies, free_flight ? 0 : 1);
+      EXPECT_EQ(stats.free_flight_bodies, free_flight ? 1 : 0);
     }
-    // The world's own path is exact in double precision; the predictor's goes through vertex
-    // accelerations and a rigid fit.
-    if (free_flight) {
-      EXPECT_LT(worst_precise, 1e-9);
-      // Constant angular velocity: 48 steps turn the box by 48·dt·|ω| about ω.
-      const Eigen::AngleAxisd turned(fixture.world.precise_pose(*box).orientation);
-      EXPECT_NEAR(turned.angle(), 48 * dt * w0.norm(), 1e-9);
-      EXPECT_LT((turned.axis() - w0.normalized()).norm(), 1e-9);
-      EXPECT_EQ(recorder->calls, 0);
-    }
-    const FIGNetStepStats& stats = fixture.world.last_step_stats();
-    EXPECT_EQ(stats.simulated_bodies, free_flight ? 0 : 1);
-    EXPECT_EQ(stats.free_flight_bodies, free_flight ? 1 : 0);
   }
+}
+
+// Bodies seeded where something may hold them move straight in their history: one placed at
+// rest on the floor (a parabola would show it as having dropped onto it at g·dt/2 a moment ago)
+// and two released 5 cm apart in the air (within d_c of each other). A body alone in the air,
+// whose broadphase box still overlaps a tilted neighbour's, falls along its parabola.
+TEST(FIGNetWorld, OnlyBodiesInFreeFlightAreSeededFalling) {
+  auto predictor = recording_predictor();
+  auto* recorder = predictor.get();
+  WorldFixture fixture(std::move(predictor), {}, FIGNetWorldOptions::network_alone());
+  fixture.add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0, Pose{});
+  auto cube = [] { return std::make_unique<btBoxShape>(btVector3(0.5f, 0.5f, 0.5f)); };
+  fixture.add(cube(), 1.0, at(Vec3(0, 0, 0.52)));  // on the floor
+  fixture.add(cube(), 1.0, at(Vec3(3, 0, 2.0)));   // a pair in the air, 5 cm apart
+  fixture.add(cube(), 1.0, at(Vec3(3, 1.05, 2.0)));
+  // Alone, with a neighbour turned 45° about x and z 1.25 m off along each axis: their
+  // broadphase boxes overlap (0.55 + 0.90 m reach in x and y, 0.55 + 0.76 in z), their bounding
+  // spheres (0.87 m) stay 0.33 m apart beyond d_c.
+  const Eigen::Quaterniond tilted =
+      Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()) * Eigen::AngleAxisd(M_PI / 4, Vec3::UnitX());
+  btRigidBody* alone = fixture.add(cube(), 1.0, at(Vec3(-6, 0, 3.0)));
+  btRigidBody* neighbour = fixture.add(cube(), 1.0, at(Vec3(-4.75, 1.25, 4.25), tilted));
+  fixture.step();
+  ASSERT_EQ(recorder->last_scene.objects.size(), 5u);
+  bool paired = false;
+  btBroadphasePairArray& pairs = fixture.world.getPairCache()->getOverlappingPairArray();
+  for (int i = 0; i < pairs.size(); ++i) {
+    const void* a = pairs[i].m_pProxy0->m_clientObject;
+    const void* b = pairs[i].m_pProxy1->m_clientObject;
+    paired = paired || (a == alone && b == neighbour) || (a == neighbour && b == alone);
+  }
+  ASSERT_TRUE(paired) << "the test needs the two boxes' broadphase boxes to overlap";
+  // The history the predictor saw (τ ≤ 0 the time before the step): the falling boxes' centres
+  // on z(τ) = z₀ − 5τ², released at rest at the parabola's top; the others' all equal.
+  const double dt = WorldFixture::kStep;
+  int falling = 0;
+  for (const SceneObject& object : recorder->last_scene.objects) {
+    const Vec3 start = object.centers.row(2).transpose();
+    const auto z = [&](int k) { return object.centers(k, 2); };
+    SCOPED_TRACE(fmt::format("box at ({}, {}, {})", start.x(), start.y(), start.z()));
+    if (start.x() < -1.0) {
+      ++falling;
+      EXPECT_NEAR(z(2) - z(1), 5.0 * dt * dt, 1e-9);
+      EXPECT_NEAR(z(2) - z(0), 5.0 * 4 * dt * dt, 1e-9);
+    } else {
+      EXPECT_EQ(z(0), z(2));
+      EXPECT_EQ(z(1), z(2));
+    }
+  }
+  EXPECT_EQ(falling, 2);
 }
 
 TEST(FIGNetWorld, AKinematicBodyFollowsItsMotionStateExactly) {
@@ -726,9 +786,10 @@ TEST(FIGNetWorld, FreeFlightLeavesBodiesInContactAsTheNetworkMovesThem) {
       EXPECT_EQ(stats.free_flight_bodies, free_flight ? with_flyer : 0);
     }
     if (flyer && free_flight) {
+      // Released at rest in free flight: seeded at the top of its parabola (seed_falling).
       const double n = 6, dt = WorldFixture::kStep;
       EXPECT_NEAR(scene.fixture.world.precise_pose(*flyer).position.z(),
-                  30 - 0.5 * n * (n + 1) * dt * dt * 10, 1e-9);
+                  30 - 0.5 * n * n * dt * dt * 10, 1e-9);
     }
     return std::pair(positions, orientations);
   };

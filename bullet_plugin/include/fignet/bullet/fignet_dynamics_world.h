@@ -39,6 +39,14 @@ struct FIGNetWorldOptions {
   // without the network, which runs only on the bodies in contact and what they touch; its cost
   // follows the contacting part of the scene. false: every awake body goes through the network.
   bool free_flight = true;
+  // A body's history is seeded from its velocities when it enters the world, wakes, or the user
+  // moves it or sets its velocity. true: one in free flight (judged by its broadphase partners:
+  // floor planes more than d_c below it, dynamic bodies whose bounding spheres are more than d_c
+  // from its own) is seeded as falling along its gravity's parabola, as bodies in the training
+  // data were, so its first steps neither fall ½·g·dt² too far nor keep a spurious g·dt/2 of
+  // downward velocity. A body that may be supported is seeded moving straight. false: every
+  // body is seeded moving straight.
+  bool seed_falling = true;
   // Islands whose bodies all want to sleep (Bullet's thresholds and deactivation time) sleep and
   // wake together when touched, as in Bullet. false: bodies never sleep.
   bool sleeping = true;
