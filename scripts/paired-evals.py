@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Two `fignet eval --json` results compared scene by scene, as `fignet eval` compares the models
-of one run: for runs that one invocation cannot hold together (other `--turns`, other builds).
+"""Two `fignet eval --json` (or two `fignet compare --json`) results compared scene by scene, as
+`fignet eval` compares the models of one run: for runs that one invocation cannot hold together
+(other `--turns`, other builds, other world options).
 
     scripts/paired-evals.py REFERENCE.json RUN.json [--reference-run NAME] [--run NAME]
 
@@ -34,7 +35,7 @@ def load_run(path, name):
         fail(f"cannot read '{path}': {error}")
     runs = result.get("runs") if isinstance(result, dict) else None
     if not runs:
-        fail(f"'{path}' is not a `fignet eval --json` result (no runs)")
+        fail(f"'{path}' is not a `fignet eval --json` or `fignet compare --json` result (no runs)")
     if name is None:
         chosen = [run for run in runs if run.get("kind") == "FIGNet"][:1]
     else:

@@ -203,15 +203,6 @@ void print_paired(const std::vector<Row>& rows, const std::vector<SceneBySceneRo
 nlohmann::json to_json(const Row& row) {
   const Evaluation& e = row.result;
   const auto number = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nullptr; };
-  nlohmann::json per_trajectory = nlohmann::json::array();
-  for (const RolloutErrors& t : e.per_trajectory) {
-    per_trajectory.push_back({{"mean_translation_m", t.mean_translation},
-                              {"final_translation_m", t.final_translation},
-                              {"mean_rotation_deg", t.mean_rotation},
-                              {"final_rotation_deg", t.final_rotation},
-                              {"predicted_travel_m", t.predicted_travel},
-                              {"true_travel_m", t.true_travel}});
-  }
   nlohmann::json regimes = nullptr;
   if (row.one_step) {
     regimes = nlohmann::json::object();
@@ -245,7 +236,7 @@ nlohmann::json to_json(const Row& row) {
           {"milliseconds_per_step", e.milliseconds_per_step},
           {"translation_per_frame_m", e.translation},
           {"rotation_per_frame_deg", e.rotation},
-          {"per_trajectory", per_trajectory}};
+          {"per_trajectory", per_trajectory_json(e.per_trajectory)}};
 }
 
 void run_eval(const EvalArgs& args) {

@@ -70,7 +70,8 @@ nlohmann::json report_json(const ReportInput& input, bool with_poses) {
                           {"mean_rotation_deg", rounded(r.mean_rotation)},
                           {"final_rotation_deg", rounded(r.final_rotation)},
                           {"translation_per_frame_m", rounded_list(r.translation)},
-                          {"rotation_per_frame_deg", rounded_list(r.rotation)}};
+                          {"rotation_per_frame_deg", rounded_list(r.rotation)},
+                          {"per_trajectory", per_trajectory_json(r.errors)}};
     const size_t k = runs.size();
     if (k < input.against_reference.size() && input.against_reference[k]) {
       run["against_reference"] = scene_by_scene_json(*input.against_reference[k]);

@@ -95,4 +95,17 @@ void print_scene_by_scene(const std::string& reference, const std::vector<std::s
   fmt::print("\n{}\n", scene_by_scene_legend());
 }
 
+nlohmann::json per_trajectory_json(const std::vector<RolloutErrors>& errors) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const RolloutErrors& t : errors) {
+    out.push_back({{"mean_translation_m", t.mean_translation},
+                   {"final_translation_m", t.final_translation},
+                   {"mean_rotation_deg", t.mean_rotation},
+                   {"final_rotation_deg", t.final_rotation},
+                   {"predicted_travel_m", t.predicted_travel},
+                   {"true_travel_m", t.true_travel}});
+  }
+  return out;
+}
+
 }  // namespace fignet::cli

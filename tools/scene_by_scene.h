@@ -34,6 +34,10 @@ nlohmann::json scene_by_scene_json(const std::optional<PairedComparison>& compar
 // {"mean_translation": ..., "mean_rotation": ...} of a row.
 nlohmann::json scene_by_scene_json(const SceneBySceneRow& row);
 
+// Each scene's figures, as `fignet eval --json` and `fignet compare --json` write them under a
+// run's "per_trajectory" (scripts/paired-evals.py pairs two such lists across files).
+nlohmann::json per_trajectory_json(const std::vector<RolloutErrors>& errors);
+
 // The section a command prints: "against REFERENCE, scene by scene", one line per labelled row
 // (labels padded to label_width), then the legend.
 void print_scene_by_scene(const std::string& reference, const std::vector<std::string>& labels,

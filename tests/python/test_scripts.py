@@ -378,3 +378,31 @@ def test_paired_evals_names_what_does_not_match(source_dir, tmp_path):
     assert "has no run 'C.h5' (its runs: A.h5, ballistic)" in result.stderr
     result = run_paired_evals(source_dir, tmp_path / "a.json", tmp_path / "missing.json")
     assert result.returncode == 1 and "cannot read" in result.stderr and "missing.json" in result.stderr
+
+
+def write_compare(path, world_translations):
+    """A `fignet compare --json` result: Bullet's runs and a model's two rows, scene by scene."""
+    def run(name, kind, translations):
+        return {"name": name, "kind": kind, "per_trajectory": [
+            {"mean_translation_m": t, "mean_rotation_deg": 10.0 * t} for t in translations]}
+    scenes = len(world_translations)
+    runs = [run("Bullet 240 Hz", "ground truth", [0.0] * scenes),
+            run("FIGNet m.h5, network alone", "FIGNet", [1.0] * scenes),
+            run("FIGNet m.h5", "FIGNet", world_translations),
+            run("Bullet 48 Hz", "Bullet", [0.5] * scenes)]
+    path.write_text(json.dumps({"data": "test.h5", "scene_count": scenes, "runs": runs}))
+
+
+def test_paired_evals_reads_compare_results(source_dir, tmp_path):
+    # Two compare results (other world options): the world's row picked by name, 3 of 4 scenes
+    # lower by a quarter, one level.
+    write_compare(tmp_path / "a.json", [1.0, 2.0, 4.0, 1.0])
+    write_compare(tmp_path / "b.json", [0.75, 1.5, 3.0, 1.0])
+    result = run_paired_evals(source_dir, tmp_path / "a.json", tmp_path / "b.json",
+                              "--run", "FIGNet m.h5", "--reference-run", "FIGNet m.h5")
+    assert result.returncode == 0, result.stderr
+    assert "mean translation (m): 2.0000 -> 1.5625  -21.9%" in result.stdout
+    assert "lower on 3/3" in result.stdout
+    # By default each side is its first FIGNet run: the network alone, level here.
+    result = run_paired_evals(source_dir, tmp_path / "a.json", tmp_path / "b.json")
+    assert result.returncode == 0 and "+0.0% [+0.0, +0.0]  lower on 0/0" in result.stdout
