@@ -32,6 +32,13 @@ def test_free_flight_with_a_model_is_exact(model):
     np.testing.assert_allclose(scene.positions[0], parabola(p0, v0, 12 * scene.time_step),
                                rtol=0, atol=1e-9)
     np.testing.assert_allclose(scene.quaternions[0], [1, 0, 0, 0], atol=1e-12)
+    # Seeded moving straight, it follows Bullet's semi-implicit Euler at the model's step.
+    straight = fignet.Scene(model, seed_falling=False)
+    straight.add_body(vertices, faces, mass=2.0, position=p0, linear_velocity=v0)
+    straight.step(12)
+    np.testing.assert_allclose(straight.positions[0],
+                               semi_implicit_euler(p0, v0, 12, straight.time_step),
+                               rtol=0, atol=1e-9)
 
 
 def test_materials_outside_the_models_data_are_named_in_one_warning(model):
