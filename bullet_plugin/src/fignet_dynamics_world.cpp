@@ -300,6 +300,7 @@ struct FIGNetDynamicsWorld::Impl {
       const Pose current = from_bt(body.getWorldTransform());
       const Vec3 linear = from_bt(body.getLinearVelocity());
       const Vec3 angular = from_bt(body.getAngularVelocity());
+      // Straight first: in_free_flight reads the body's current pose from its history.
       state.poses = seed_history(current, linear, angular, graph.history, time_step);
       state.valid = true;
       if (options.seed_falling && in_free_flight(body)) {
