@@ -316,24 +316,26 @@ void run_train(const TrainArgs& args) {
   ProgressBar bar(root ? "train" : "", config.steps, trainer.steps_done());
   const std::int64_t first_step = trainer.steps_done();
   auto last_checkpoint = std::chrono::steady_clock::now();
-  double loss_sum = 0.0, norm_sum = 0.0;
+  double loss_sum = 0.0, norm_sum = 0.0, gap_sum = 0.0;
   int loss_count = 0;
   std::int64_t window_start_step = trainer.steps_done();
   double window_start_time = bar.seconds();
   bool stopped = false;
   while (trainer.steps_done() < config.steps && !(stopped = stop_agreed())) {
     const TrainStep step = trainer.step();
-    loss_sum += step.loss, norm_sum += step.gradient_norm, ++loss_count;
+    loss_sum += step.loss, norm_sum += step.gradient_norm, gap_sum += step.heading_gap;
+    ++loss_count;
     if (!root) continue;
     if (step.step % args.log_every == 0 || step.step == config.steps) {
       const double now = bar.seconds();
       const double rate = (step.step - window_start_step) / std::max(1e-9, now - window_start_time);
+      const bool consistent = config.trainer.heading_consistency > 0.0f;
       log->write_step(step.step, loss_sum / loss_count, step.learning_rate, rate,
-                      norm_sum / loss_count);
+                      norm_sum / loss_count, consistent ? gap_sum / loss_count : -1.0);
       bar.update(step.step,
                  fmt::format("loss {:.4f}  {:.1f} steps/s  {:.0f} samples/s", loss_sum / loss_count,
                              rate, rate * config.trainer.batch_size));
-      loss_sum = 0.0, norm_sum = 0.0, loss_count = 0;
+      loss_sum = 0.0, norm_sum = 0.0, gap_sum = 0.0, loss_count = 0;
       window_start_step = step.step, window_start_time = now;
     }
     if (step.step % args.valid_every == 0 || step.step == config.steps) validate(step.step);
@@ -352,7 +354,7 @@ void run_train(const TrainArgs& args) {
       std::max<double>(1.0, static_cast<double>(trainer.steps_done() - first_step));
   fmt::print(
       "per step ({} scenes): {:.1f} ms building graphs{}, {:.1f} ms input statistics, {:.1f} ms "
-      "network ({}), {:.1f} ms Adam{}\n",
+      "network ({}), {:.1f} ms Adam{}{}\n",
       config.trainer.batch_size, 1e3 * times.build / steps_run,
       trainer.builds_ahead()
           ? fmt::format(" ({:.1f} ms of it waited for, the rest beside the step before)",
@@ -363,6 +365,10 @@ void run_train(const TrainArgs& args) {
       config.trainer.pushforward_fraction > 0.0f
           ? fmt::format(", {:.1f} ms pushing scenes forward (its forward passes and graphs)",
                         1e3 * times.pushforward / steps_run)
+          : "",
+      config.trainer.heading_consistency > 0.0f
+          ? fmt::format(", {:.1f} ms predicting turned copies (heading_consistency)",
+                        1e3 * times.heading / steps_run)
           : "");
   if (const std::string profile = trainer.backend().profile(); !profile.empty()) {
     fmt::print("{}: {}\n", trainer.backend().name(), profile);

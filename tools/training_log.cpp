@@ -54,13 +54,14 @@ std::int64_t TrainingLog::samples_at(std::int64_t step) const {
 }
 
 void TrainingLog::write_step(std::int64_t step, double loss, float learning_rate,
-                             double steps_per_second, double gradient_norm) {
+                             double steps_per_second, double gradient_norm, double heading_gap) {
   nlohmann::json line{{"step", step},
                       {"samples", samples_at(step)},
                       {"loss", loss},
                       {"learning_rate", learning_rate},
                       {"steps_per_second", steps_per_second},
                       {"gradient_norm", gradient_norm}};
+  if (heading_gap >= 0.0) line["heading_gap"] = heading_gap;
   // Which steps ran on bf16 products (--bf16): their bits and speed differ from f32 ones.
   if (gemm_precision() == GemmPrecision::kBf16) line["products"] = "bf16";
   out_ << line.dump() << std::endl;

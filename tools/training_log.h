@@ -23,8 +23,9 @@ class TrainingLog {
   TrainingLog(const std::filesystem::path& path, std::int64_t resume_step, int resumed_batch_size,
               int batch_size);
 
+  // `heading_gap` (TrainStep::heading_gap) is written when not negative.
   void write_step(std::int64_t step, double loss, float learning_rate, double steps_per_second,
-                  double gradient_norm);
+                  double gradient_norm, double heading_gap = -1.0);
   // Validation rollouts and the one-step errors by regime of the same trajectories.
   void write_validation(std::int64_t step, const Evaluation& evaluation,
                         const OneStepTotals& one_step);

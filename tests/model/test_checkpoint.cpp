@@ -52,6 +52,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   trainer_config.pushforward_fraction = 0.5f;
   trainer_config.pushforward_skips_rest = true;
   trainer_config.pushforward_steps = 2;
+  trainer_config.heading_consistency = 0.5f;
   Trainer uninterrupted(tiny_model(), trainer_config, data);
   uninterrupted.run(10, nullptr);
 
@@ -70,6 +71,7 @@ TEST_F(Checkpoints, ResumingContinuesBitForBit) {
   EXPECT_EQ(checkpoint.trainer_config.pushforward_fraction, 0.5f);
   EXPECT_TRUE(checkpoint.trainer_config.pushforward_skips_rest);
   EXPECT_EQ(checkpoint.trainer_config.pushforward_steps, 2);
+  EXPECT_EQ(checkpoint.trainer_config.heading_consistency, 0.5f);
   Trainer resumed(checkpoint.model->config(), checkpoint.trainer_config, data,
                   checkpoint.model.get());
   resumed.restore(checkpoint.state);
@@ -96,6 +98,7 @@ TEST_F(Checkpoints, AFileWithoutLaterFieldsReadsWhatOlderRunsTrainedWith) {
   trainer_config.pushforward_fraction = 0.5f;
   trainer_config.pushforward_skips_rest = true;
   trainer_config.pushforward_steps = 3;
+  trainer_config.heading_consistency = 0.5f;
   const auto data = falling_cubes();
   Trainer trainer(tiny_model(), trainer_config, data);
   const fs::path path = dir_ / "run.ckpt.h5";
@@ -106,7 +109,7 @@ TEST_F(Checkpoints, AFileWithoutLaterFieldsReadsWhatOlderRunsTrainedWith) {
     for (const char* name :
          {"gradient_clip", "huber_delta", "statistics_warmup", "rest_loss_weight",
           "impact_loss_weight", "weight_average", "still_air_fraction", "pushforward_fraction",
-          "pushforward_skips_rest", "pushforward_steps", "planned_steps"}) {
+          "pushforward_skips_rest", "pushforward_steps", "heading_consistency", "planned_steps"}) {
       training.removeAttr(name);
     }
   }
@@ -122,6 +125,7 @@ TEST_F(Checkpoints, AFileWithoutLaterFieldsReadsWhatOlderRunsTrainedWith) {
   EXPECT_EQ(checkpoint.trainer_config.pushforward_fraction, defaults.pushforward_fraction);
   EXPECT_EQ(checkpoint.trainer_config.pushforward_skips_rest, defaults.pushforward_skips_rest);
   EXPECT_EQ(checkpoint.trainer_config.pushforward_steps, defaults.pushforward_steps);
+  EXPECT_EQ(checkpoint.trainer_config.heading_consistency, defaults.heading_consistency);
   EXPECT_EQ(checkpoint.planned_steps, 0);
 }
 

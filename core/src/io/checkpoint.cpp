@@ -31,6 +31,7 @@ void write_training(H5::Group group, const TrainerConfig& config, const TrainerS
   write_attribute(group, "pushforward_skips_rest",
                   static_cast<long long>(config.pushforward_skips_rest ? 1 : 0));
   write_attribute(group, "pushforward_steps", static_cast<long long>(config.pushforward_steps));
+  write_attribute(group, "heading_consistency", double{config.heading_consistency});
   write_attribute(group, "step", static_cast<long long>(state.step));
   write_attribute(group, "rng", state.rng);
   const hsize_t n = state.first_moment.size();
@@ -68,6 +69,7 @@ void read_training(const H5::Group& group, size_t parameters, const std::string&
       read_integer_or(group, "pushforward_skips_rest", config.pushforward_skips_rest ? 1 : 0) != 0;
   config.pushforward_steps =
       static_cast<int>(read_integer_or(group, "pushforward_steps", config.pushforward_steps));
+  config.heading_consistency = read_float_or("heading_consistency", config.heading_consistency);
   state.step = read_integer(group, "step");
   state.rng = read_string(group, "rng");
   for (auto [name, out] : {std::pair("adam_first_moment", &state.first_moment),

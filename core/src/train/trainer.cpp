@@ -96,6 +96,11 @@ Trainer::Trainer(const ModelConfig& config, const TrainerConfig& trainer_config,
     throw ConfigError(fmt::format("trainer: pushforward_steps = {} (must be in 1..{})",
                                   trainer_config.pushforward_steps, kMaxPushforwardSteps));
   }
+  if (!(trainer_config.heading_consistency >= 0.0f) ||
+      !std::isfinite(trainer_config.heading_consistency)) {
+    throw ConfigError(fmt::format("trainer: heading_consistency = {} (must be >= 0; 0: none)",
+                                  trainer_config.heading_consistency));
+  }
   if (trainer_config.pushforward_fraction > 0.0f && config.graph.history < 1) {
     throw ConfigError(
         "trainer: pushforward_fraction > 0 needs history >= 1 (a velocity to push forward)");
@@ -360,6 +365,68 @@ void Trainer::push_forward_current() {
   times_.pushforward += seconds_since(start);
 }
 
+void Trainer::predict_turned_current() {
+  const auto start = std::chrono::steady_clock::now();
+  const PreparedBatch& batch = current();
+  const int scenes = static_cast<int>(batch.scenes.size());
+  // One angle per scene from a generator of its own, seeded by the scene's noise seed: the
+  // batch's other draws stay what they were without the term.
+  std::vector<double>& angles = turned_.scene_yaw;
+  angles.resize(scenes);
+  for (int b = 0; b < scenes; ++b) {
+    const std::uint64_t seed = batch.scene_seeds[b];
+    std::seed_seq turn_seeds{static_cast<std::uint32_t>(seed),
+                             static_cast<std::uint32_t>(seed >> 32), std::uint32_t{0x7e4d}};
+    std::mt19937_64 turn(turn_seeds);
+    angles[b] = std::uniform_real_distribution<double>(0.0, 2.0 * std::numbers::pi)(turn);
+  }
+  turned_.samples = batch.samples;
+  turned_.scenes.resize(scenes);
+  turned_.scene_targets.resize(scenes);
+  turned_.scene_motion = batch.scene_motion;
+  // The turned copies built into a graph of their own, as the batch was.
+  build_graph(omp_get_max_threads(), turned_, [&](int begin, int end) {
+    for (int b = begin; b < end; ++b) {
+      turned_.scenes[b] = batch.scenes[b];
+      turned_.scene_targets[b] = batch.scene_targets[b];
+      turn_about_vertical(angles[b], turned_.scenes[b], turned_.scene_targets[b]);
+    }
+  });
+  const ConstMatrixView output =
+      backend_->forward(params_.data(), normalizers_, turned_.graph, false);
+  turned_prediction_.resize(output.rows(), 3);
+  normalizers_.target.denormalize(output, turned_prediction_);
+  // Rows pair up where a scene has the same objects with the same nodes in both graphs (with
+  // omit_free_flight, a turn could in principle change which bodies are near contact by rounding);
+  // each such scene's rows are turned back by its angle, in the batch graph's order.
+  const Graph& graph = batch.graph;
+  const Graph& turned = turned_.graph;
+  RowMatrixXf turned_back(graph.num_mesh_nodes(), 3);
+  turned_back.setZero();
+  turned_rows_.assign(graph.num_mesh_nodes(), 0);
+  for (int b = 0; b < scenes && b < graph.num_scenes() && b < turned.num_scenes(); ++b) {
+    const int objects = graph.scene_first_object[b + 1] - graph.scene_first_object[b];
+    if (turned.scene_first_object[b + 1] - turned.scene_first_object[b] != objects) continue;
+    const int first = graph.object_first_node[graph.scene_first_object[b]];
+    const int turned_first = turned.object_first_node[turned.scene_first_object[b]];
+    bool same = true;
+    for (int o = 0; o <= objects && same; ++o) {
+      same = graph.object_first_node[graph.scene_first_object[b] + o] - first ==
+             turned.object_first_node[turned.scene_first_object[b] + o] - turned_first;
+    }
+    if (!same) continue;
+    const int rows = graph.object_first_node[graph.scene_first_object[b + 1]] - first;
+    // Rows are turned by v·Rᵀ, so v·R turns them back.
+    const Eigen::Matrix3f back =
+        Eigen::AngleAxisd(angles[b], Vec3::UnitZ()).toRotationMatrix().cast<float>();
+    turned_back.middleRows(first, rows) = turned_prediction_.middleRows(turned_first, rows) * back;
+    std::fill_n(turned_rows_.begin() + first, rows, std::uint8_t{1});
+  }
+  turned_prediction_.resize(graph.num_mesh_nodes(), 3);
+  normalizers_.target.normalize(turned_back, turned_prediction_);
+  times_.heading += seconds_since(start);
+}
+
 void Trainer::set_build_ahead(bool on) {
   if (on && !ahead_) ahead_ = std::make_unique<detail::BackgroundTask>();
   if (!on && ahead_) {
@@ -466,6 +533,7 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
       std::fill(grads_.begin(), grads_.end(), 0.0f);
       last_gradient_norm_ = 0.0;
     }
+    last_heading_gap_ = 0.0;
     return 0.0;
   }
   // Squared error, or Huber's: quadratic within delta, linear beyond (scaled to match at 0).
@@ -478,6 +546,10 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
     return delta <= 0.0 || std::abs(error) <= delta ? error : std::copysign(delta, error);
   };
   const float scale = 2.0f / static_cast<float>(3 * count);
+  // With heading_consistency, the turned prediction as a second target of weight `consistency`
+  // (predict_turned_current ran on this batch).
+  const float consistency = with_gradient ? trainer_config_.heading_consistency : 0.0f;
+  if (consistency > 0.0f) node_heading_gap_.assign(batch.targets.rows(), 0.0);
   // The loss of the output rows of nodes [first, first + rows), and its gradient when asked.
   const bool weighted = weighs_bodies();
   auto node_loss = [&](int first, const ConstMatrixRef& output, MatrixRef* d_output) {
@@ -491,6 +563,16 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
         const double error = output(r, c) - normalized_targets_(i, c);
         squares += weight * loss_of(error);
         if (d_output) (*d_output)(r, c) = scale * weight * slope_of(error);
+      }
+      if (consistency > 0.0f && turned_rows_[i]) {
+        // Chunks run on several threads: each row's gap has its own slot, summed in row order.
+        double gaps = 0.0;
+        for (int c = 0; c < 3; ++c) {
+          const float gap = output(r, c) - turned_prediction_(i, c);
+          gaps += double(gap) * gap;
+          (*d_output)(r, c) += scale * weight * consistency * gap;
+        }
+        node_heading_gap_[i] = weight * gaps;
       }
     }
     return squares;
@@ -507,7 +589,13 @@ double Trainer::loss_and_gradient(bool with_gradient, bool reduce) {
     squares =
         node_loss(0, backend_->forward(params_.data(), normalizers_, batch.graph, false), nullptr);
   }
-  if (reduce) collective_->sum(std::span<double>(&squares, 1));
+  double sums[2] = {squares, 0.0};
+  if (consistency > 0.0f) {
+    for (const double gap : node_heading_gap_) sums[1] += gap;
+  }
+  if (reduce) collective_->sum(std::span<double>(sums, 2));
+  squares = sums[0];
+  last_heading_gap_ = sums[1] / (3 * count);
   if (with_gradient) {
     // Each process's gradient is its part of the global mean's: their sum is the whole.
     if (reduce) collective_->sum(std::span<float>(grads_.data(), grads_.size()));
@@ -542,11 +630,14 @@ TrainStep Trainer::train_on_current() {
   const auto statistics_start = std::chrono::steady_clock::now();
   accumulate_statistics();
   times_.statistics += seconds_since(statistics_start);
+  // After the statistics: both predictions normalised alike.
+  if (trainer_config_.heading_consistency > 0.0f) predict_turned_current();
   TrainStep result;
   result.learning_rate = adam_.learning_rate();
   auto start = std::chrono::steady_clock::now();
   result.loss = loss_and_gradient(true, true);
   result.gradient_norm = last_gradient_norm_;
+  result.heading_gap = last_heading_gap_;
   times_.network += seconds_since(start);
   start = std::chrono::steady_clock::now();
   adam_.update(params_, grads_);

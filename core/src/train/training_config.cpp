@@ -141,6 +141,8 @@ const std::vector<std::pair<std::string, Field>>& fields() {
        plain<bool>([](TrainingConfig & c) -> auto& { return c.trainer.pushforward_skips_rest; })},
       {"pushforward_steps",
        plain<int>([](TrainingConfig & c) -> auto& { return c.trainer.pushforward_steps; })},
+      {"heading_consistency",
+       plain<float>([](TrainingConfig & c) -> auto& { return c.trainer.heading_consistency; })},
       {"statistics_warmup",
        plain<int>([](TrainingConfig & c) -> auto& { return c.trainer.statistics_warmup; })},
       {"data_seed",
@@ -353,6 +355,12 @@ void TrainingConfig::validate() const {
         "pushforward_steps = {} (must be in 1..{}: the network's steps from the frame a pushed "
         "scene is drawn at to its own)",
         trainer.pushforward_steps, kMaxPushforwardSteps));
+  }
+  if (!(trainer.heading_consistency >= 0.0f) || !std::isfinite(trainer.heading_consistency)) {
+    throw ConfigError(fmt::format(
+        "heading_consistency = {} (must be >= 0: the loss weight of the difference between a "
+        "prediction and the prediction for the scene turned about the vertical; 0: none)",
+        trainer.heading_consistency));
   }
   if (!(trainer.weight_average >= 0.0f && trainer.weight_average < 1.0f)) {
     throw ConfigError(fmt::format(

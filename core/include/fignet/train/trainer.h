@@ -79,6 +79,13 @@ struct TrainerConfig {
   // by the network, so the step trains on inputs with a short rollout's accumulated error, not
   // one step's. Each step more costs one forward pass and one graph build more per pushed step.
   int pushforward_steps = 1;
+  // Weight in the loss of the squared difference between each dynamic node's prediction and the
+  // prediction for the same scene turned about the vertical by a random angle and turned back,
+  // which counts as a target, without a gradient (0: none). Physics does not change with the
+  // heading; the network does, a little: `turns` averages that away at run time for turns× the
+  // network's cost, this term trains it away. The difference is measured on the batch as trained
+  // (after the push). Costs one graph build and one forward pass more per step.
+  float heading_consistency = 0.0f;
 };
 
 inline constexpr int kMaxPushforwardSteps = 8;
@@ -105,6 +112,8 @@ struct TrainerTimes {
   // The pushforward's own forward passes and graph builds (pushforward_fraction), apart from the
   // phases above.
   double pushforward = 0.0;
+  // heading_consistency's graph builds and forward passes of the turned copies.
+  double heading = 0.0;
 };
 
 struct TrainStep {
@@ -112,6 +121,10 @@ struct TrainStep {
   double loss = 0.0;      // mean squared normalised error over the batch's dynamic nodes (weighted)
   float learning_rate = 0.0f;
   double gradient_norm = 0.0;  // global L2 norm of the gradient, before any clipping
+  // With heading_consistency: the mean squared normalised difference between the batch's
+  // predictions and those of its turned copy turned back, over the loss's nodes (weighted as the
+  // loss); not part of `loss`, which stays the fit to the data.
+  double heading_gap = 0.0;
 };
 
 class Trainer {
@@ -165,6 +178,9 @@ class Trainer {
   const std::vector<Scene>& batch_scenes() const { return current().scenes; }
   const std::vector<Points>& batch_targets() const { return current().scene_targets; }
   const std::vector<std::uint8_t>& batch_pushed() const { return current().scene_pushed; }
+  // With heading_consistency: the angle (radians, about the vertical) each scene of the last
+  // step was turned by for the prediction it was held to; empty otherwise.
+  const std::vector<double>& batch_heading_turns() const { return turned_.scene_yaw; }
   // The graph the last step trained on (with omit_free_flight, of the bodies in contact only).
   const Graph& batch_graph() const { return current().graph; }
 
@@ -240,6 +256,11 @@ class Trainer {
   // Advances the current batch's pushed scenes to the network's own prediction of their next
   // frame and rebuilds its graph (pushforward_fraction); nothing when none is pushed.
   void push_forward_current();
+  // The network's prediction for the current batch turned about the vertical by a random angle
+  // per scene, turned back and normalised, into turned_prediction_ in the batch graph's row order,
+  // with turned_rows_ marking the rows whose node is the same in both graphs
+  // (heading_consistency).
+  void predict_turned_current();
   // Statistics, forward, backward and Adam on the current batch.
   TrainStep train_on_current();
   PreparedBatch& current() { return batches_[current_]; }
@@ -281,6 +302,11 @@ class Trainer {
   int current_ = 0;
   RowMatrixXf normalized_targets_;
   RowMatrixXf pushforward_accelerations_;
+  PreparedBatch turned_;  // the current batch turned (heading_consistency)
+  RowMatrixXf turned_prediction_;
+  std::vector<std::uint8_t> turned_rows_;
+  std::vector<double> node_heading_gap_;  // per row, summed in row order after the passes
+  double last_heading_gap_ = 0.0;
   Normalizers batch_statistics_;
   std::vector<double> statistics_buffer_;
   TrainerTimes times_;
