@@ -40,25 +40,41 @@ TEST(Ops, ScatterAddIsTheAdjointOfGatherAdd) {
   EXPECT_EQ(second[2], index[7]);
 }
 
-TEST(Ops, GatheredProductEqualsGatherThenMultiply) {
-  std::mt19937 rng(2);
-  const RowMatrixXf x = random_matrix(rng, 9, 4), w = random_matrix(rng, 4, 6);
-  const auto index = random_index(rng, 30, 9);
-  RowMatrixXf z = RowMatrixXf::Zero(30, 6), gathered = RowMatrixXf::Zero(30, 4);
+// Both ways of forming a gathered product (per node then gathered, where the edges outnumber the
+// nodes; gathered then per edge, where they do not) against the explicit gather-then-multiply,
+// on a nonzero z and dx that they must add to, and through a strided span as face edges use.
+class GatheredProduct : public ::testing::TestWithParam<int> {};
+
+TEST_P(GatheredProduct, EqualsGatherThenMultiply) {
+  const int edges = GetParam(), nodes = 9;
+  std::mt19937 rng(2 + edges);
+  const RowMatrixXf x = random_matrix(rng, nodes, 4), w = random_matrix(rng, 4, 6);
+  const auto index = random_index(rng, 3 * edges, nodes);
+  const IndexSpan span{index.data(), edges, 3, 2};  // every third entry from the third
+  const RowMatrixXf z0 = random_matrix(rng, edges, 6);
+  RowMatrixXf z = z0, gathered = RowMatrixXf::Zero(edges, 4);
   Buffer scratch;
-  add_gathered_product(x, w, {index.data(), 30}, z, scratch);
-  gather_add(x, {index.data(), 30}, gathered);
-  EXPECT_TRUE(z.isApprox(gathered * w, 1e-5f));
-  // Its adjoint against the explicit form: dx = scatter(dz·wᵀ), dw = gatheredᵀ·dz.
-  const RowMatrixXf dz = random_matrix(rng, 30, 6);
-  RowMatrixXf dw = RowMatrixXf::Zero(4, 6), dx = RowMatrixXf::Zero(9, 4);
+  add_gathered_product(x, w, span, z, scratch);
+  gather_add(x, span, gathered);
+  EXPECT_TRUE(z.isApprox(z0 + gathered * w, 1e-5f));
+  // Its adjoint against the explicit form: dx += scatter(dz·wᵀ), dw += gatheredᵀ·dz.
+  const RowMatrixXf dz = random_matrix(rng, edges, 6);
+  const RowMatrixXf dw0 = random_matrix(rng, 4, 6), dx0 = random_matrix(rng, nodes, 4);
+  RowMatrixXf dw = dw0, dx = dx0;
   MatrixRef dx_ref = dx;
-  backprop_gathered_product(x, w, {index.data(), 30}, dz, dw, &dx_ref, scratch);
-  RowMatrixXf expected_dx = RowMatrixXf::Zero(9, 4);
-  scatter_add(dz * w.transpose(), {index.data(), 30}, expected_dx);
-  EXPECT_TRUE(dw.isApprox(gathered.transpose() * dz, 1e-4f));
+  backprop_gathered_product(x, w, span, dz, dw, &dx_ref, scratch);
+  RowMatrixXf expected_dx = dx0;
+  scatter_add(dz * w.transpose(), span, expected_dx);
+  EXPECT_TRUE(dw.isApprox(dw0 + gathered.transpose() * dz, 1e-4f));
   EXPECT_TRUE(dx.isApprox(expected_dx, 1e-4f));
+  // Without dx only the weight gradient accumulates.
+  RowMatrixXf dw_only = dw0;
+  backprop_gathered_product(x, w, span, dz, dw_only, nullptr, scratch);
+  EXPECT_TRUE(dw_only.isApprox(dw, 1e-5f));
 }
+
+// 30 edges over 9 nodes (multiplied per node), 9 (the boundary), 4 (gathered first), 1.
+INSTANTIATE_TEST_SUITE_P(Ops, GatheredProduct, ::testing::Values(30, 9, 4, 1));
 
 class MlpGradient : public ::testing::TestWithParam<bool> {};
 

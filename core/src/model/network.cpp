@@ -1,5 +1,7 @@
 #include "fignet/model/network.h"
 
+#include <algorithm>
+
 #include "fignet/nn/gemm.h"
 #include "fignet/nn/ops.h"
 
@@ -295,10 +297,14 @@ double Network::forward_flops(const Graph& graph) const {
     flops += dense(edges, edges_of(graph, t).features.cols(), l);
     const double senders = sender_set(t) == NodeSet::kMesh ? nodes : objects;
     const double receivers = receiver_set(t) == NodeSet::kMesh ? nodes : objects;
-    per_step += 2.0 * (edges + senders + receivers) * l * l + tail(edges, l);
+    // A gathered block costs a product per node or per edge, whichever is fewer (ops.h).
+    per_step += 2.0 * (edges + std::min(edges, senders) + std::min(edges, receivers)) * l * l +
+                tail(edges, l);
     if (receiver_set(t) == NodeSet::kMesh) ++mesh_blocks;
   }
-  if (face_edges_) per_step += 2.0 * 3 * (faces + 2 * nodes) * l * l + tail(faces, 3 * l);
+  if (face_edges_) {
+    per_step += 2.0 * 3 * (faces + 2 * std::min(faces, nodes)) * l * l + tail(faces, 3 * l);
+  }
   if (config_.graph.object_nodes) per_step += 2.0 * objects * 2 * l * l + tail(objects, l);
   per_step += 2.0 * nodes * mesh_blocks * l * l + tail(nodes, l);
   return flops + m * per_step;
