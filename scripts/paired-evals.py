@@ -64,7 +64,9 @@ def main():
         fail(f"the two results are of different scenes ({reference_data}, {len(reference)} "
              f"trajectories; {run_data}, {len(run)})")
 
-    print(f"{len(run)} scenes of {', '.join(run_data or [])}; {args.run} against {args.reference}")
+    # eval's "data" lists its files; compare's is the one file it simulated.
+    files = [run_data] if isinstance(run_data, str) else (run_data or [])
+    print(f"{len(run)} scenes of {', '.join(files)}; {args.run} against {args.reference}")
     for label, field in (("mean translation (m)", "mean_translation_m"),
                          ("mean rotation (deg)", "mean_rotation_deg")):
         a = [trajectory[field] for trajectory in reference]

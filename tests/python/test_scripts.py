@@ -362,6 +362,7 @@ def test_paired_evals_compares_scene_by_scene(source_dir, tmp_path):
     write_eval(tmp_path / "b.json", "test.h5", "B.h5", [0.5, 1.0, 0.25, 1.5, 0.75, 0.125])
     result = run_paired_evals(source_dir, tmp_path / "a.json", tmp_path / "b.json")
     assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("6 scenes of test.h5;")
     translation = [line for line in result.stdout.splitlines() if line.startswith("mean trans")]
     assert len(translation) == 1, result.stdout
     assert "-50.0% [-50.0, -50.0]  lower on 6/6  p=0.031" in translation[0]
@@ -401,6 +402,7 @@ def test_paired_evals_reads_compare_results(source_dir, tmp_path):
     result = run_paired_evals(source_dir, tmp_path / "a.json", tmp_path / "b.json",
                               "--run", "FIGNet m.h5", "--reference-run", "FIGNet m.h5")
     assert result.returncode == 0, result.stderr
+    assert "4 scenes of test.h5;" in result.stdout  # compare names one file, eval a list
     assert "mean translation (m): 2.0000 -> 1.5625  -21.9%" in result.stdout
     assert "lower on 3/3" in result.stdout
     # By default each side is its first FIGNet run: the network alone, level here.
