@@ -152,8 +152,9 @@ void add_compare_command(CLI::App& app) {
   cmd->add_option("--frames", args->frames, "Simulate N frames (default: the file's)")
       ->check(CLI::Range(2, 100000));
   cmd->add_option("--threads", args->threads,
-                  "Threads for the network's matrix products (0: every core; more than one "
-                  "only helps large scenes on an otherwise idle machine)")
+                  "Threads for the network's matrix products, or with --turns for the turned "
+                  "copies, one per thread (0: every core; more than one helps large scenes and "
+                  "--turns on an otherwise idle machine)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--turns", args->turns,

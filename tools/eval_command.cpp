@@ -335,8 +335,9 @@ void add_eval_command(CLI::App& app) {
                 "Skip the one-step errors by regime (free flight, moving contact, rest) and the "
                 "count of impacts without a collision edge");
   cmd->add_option("--threads", args->threads,
-                  "Threads for the network's matrix products (0: every core; more than one "
-                  "only helps large scenes on an otherwise idle machine)")
+                  "Threads for the network's matrix products, or with --turns for the turned "
+                  "copies, one per thread (0: every core; more than one helps large scenes and "
+                  "--turns on an otherwise idle machine)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--turns", args->turns,

@@ -898,6 +898,47 @@ TEST(ModelPredictor, PredictionsAveragedOverTurnsTurnWithTheScene) {
   EXPECT_LT(turned_prediction_difference(four, in_air.scene, half), 1e-5);
 }
 
+TEST(ModelPredictor, TurnedCopiesOnSeveralThreadsPredictAsOnOne) {
+  // With threads other than 1 the turned copies run one per thread, each on its own builder,
+  // graph and workspace: the same predictions as one after another (products on one thread each
+  // against products shared out: float tolerance), and last_graph() still the scene's own, for
+  // the plain build, Bullet's candidate pairs and the free-flight split.
+  const auto fixture = testing::make_random_scene(13, 5, 2.0);
+  auto model = random_model(fixture.scene);
+  std::vector<ObjectPair> all_pairs;
+  const int n = static_cast<int>(fixture.scene.objects.size());
+  for (int a = 0; a < n; ++a) {
+    for (int b = a + 1; b < n; ++b) all_pairs.push_back({a, b});
+  }
+  for (const bool free_flight : {false, true}) {
+    for (const bool with_candidates : {false, true}) {
+      SCOPED_TRACE(::testing::Message()
+                   << "free_flight " << free_flight << ", candidates " << with_candidates);
+      ModelPredictor one(model, {.threads = 1, .turns = 4, .free_flight = free_flight});
+      Points expected, predicted;
+      auto predict = [&](ModelPredictor& predictor, Points& out) {
+        if (with_candidates) {
+          predictor.predict_with_candidates(fixture.scene, all_pairs, out);
+        } else {
+          predictor.predict(fixture.scene, out);
+        }
+      };
+      predict(one, expected);
+      for (const int threads : {2, 3}) {
+        ModelPredictor several(model, {.threads = threads, .turns = 4, .free_flight = free_flight});
+        for (int step = 0; step < 2; ++step) {  // the second reuses every copy's buffers
+          predict(several, predicted);
+          ASSERT_EQ(predicted.rows(), expected.rows());
+          EXPECT_LT((predicted - expected).cwiseAbs().maxCoeff(),
+                    1e-5 * expected.cwiseAbs().maxCoeff());
+          EXPECT_EQ(several.last_graph().num_mesh_nodes(), one.last_graph().num_mesh_nodes());
+          EXPECT_EQ(several.last_face_edges(), one.last_face_edges());
+        }
+      }
+    }
+  }
+}
+
 TEST(ModelPredictor, TurnAveragingCancelsAConstantHorizontalBias) {
   // Zero weights: the network's output is 0 in normalised units, so every node is predicted the
   // target normaliser's mean b (std 1). Turned back, the half-turned scene's prediction is

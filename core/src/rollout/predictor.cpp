@@ -47,14 +47,23 @@ ModelPredictor::ModelPredictor(std::shared_ptr<const Model> model, const Predict
   options.validate();
 }
 
+int ModelPredictor::turn_threads() const {
+  const int threads = options_.threads > 0 ? options_.threads : Eigen::nbThreads();
+  return std::min(threads, options_.turns);
+}
+
 template <typename Build>
 void ModelPredictor::predict_averaged(const Scene& scene, Build&& build, Points& accelerations) {
+  if (options_.turns > 1 && turn_threads() > 1) {
+    predict_turns_in_parallel(scene, build, accelerations);
+    return;
+  }
   // The turned scenes first, so that last_graph() is the scene's own.
   for (int k = 1; k < options_.turns; ++k) {
     const double angle = 2.0 * std::numbers::pi * k / options_.turns;
     turned_ = scene;  // copy-assigned: a steady-state step reuses the last one's buffers
     turn_about_vertical(angle, turned_);
-    build(turned_);
+    build(turned_, builder_, graph_);
     run_network(turned_, turned_accelerations_);
     // Row vectors turned by a ↦ a·Rᵀ turn back by a ↦ a·R.
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, Vec3::UnitZ()).toRotationMatrix();
@@ -64,9 +73,56 @@ void ModelPredictor::predict_averaged(const Scene& scene, Build&& build, Points&
       turned_sum_.noalias() += turned_accelerations_ * turn;
     }
   }
-  build(scene);
+  build(scene, builder_, graph_);
   run_network(scene, accelerations);
   if (options_.turns > 1) accelerations = (accelerations + turned_sum_) / options_.turns;
+}
+
+template <typename Build>
+void ModelPredictor::predict_turns_in_parallel(const Scene& scene, Build& build,
+                                               Points& accelerations) {
+  const int turns = options_.turns;
+  while (static_cast<int>(copies_.size()) < turns - 1) {
+    copies_.push_back(std::make_unique<TurnedCopy>(model_->config().graph));
+  }
+  copy_errors_.resize(turns);
+  // Copy 0 is the scene itself, on the predictor's own builder and graph (last_graph()); inside
+  // the parallel loop every product runs on its calling thread alone (gemm.h).
+#pragma omp parallel for num_threads(turn_threads()) schedule(dynamic, 1)
+  for (int k = 0; k < turns; ++k) {
+    try {
+      if (k == 0) {
+        build(scene, builder_, graph_);
+        run_network_on(scene, graph_, workspace_, denormalized_, accelerations);
+      } else {
+        TurnedCopy& copy = *copies_[k - 1];
+        copy.scene = scene;  // copy-assigned: a steady-state step reuses the last one's buffers
+        turn_about_vertical(2.0 * std::numbers::pi * k / turns, copy.scene);
+        build(copy.scene, copy.builder, copy.graph);
+        run_network_on(copy.scene, copy.graph, copy.workspace, copy.denormalized,
+                       copy.accelerations);
+      }
+    } catch (...) {
+      copy_errors_[k] = std::current_exception();
+    }
+  }
+  for (std::exception_ptr& error : copy_errors_) {
+    if (!error) continue;
+    const std::exception_ptr first = error;
+    std::fill(copy_errors_.begin(), copy_errors_.end(), nullptr);
+    std::rethrow_exception(first);
+  }
+  // Turned back and summed in the order of the one-thread path, so both give the same sums.
+  for (int k = 1; k < turns; ++k) {
+    const double angle = 2.0 * std::numbers::pi * k / turns;
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, Vec3::UnitZ()).toRotationMatrix();
+    if (k == 1) {
+      turned_sum_.noalias() = copies_[k - 1]->accelerations * turn;
+    } else {
+      turned_sum_.noalias() += copies_[k - 1]->accelerations * turn;
+    }
+  }
+  accelerations = (accelerations + turned_sum_) / turns;
 }
 
 const Scene& ModelPredictor::with_fitted_masses(const Scene& scene) {
@@ -117,15 +173,15 @@ void ModelPredictor::predict_objects(const Scene& scene,
   // A turn about the vertical moves no object into or out of a pair: the candidates stand. The
   // kept scene itself is built from the split's search, and the whole scene from the caller's; a
   // turned copy meets the floor's faces elsewhere and is searched.
-  auto build = [&](const Scene& s) {
+  auto build = [&](const Scene& s, GraphBuilder& builder, Graph& graph) {
     if (&s == &kept_) {
-      builder_.build_with_contacts(std::span(&kept_, 1), std::span(&kept_contacts_, 1), graph_);
+      builder.build_with_contacts(std::span(&kept_, 1), std::span(&kept_contacts_, 1), graph);
     } else if (search && &s == &scene) {
-      builder_.build_with_contacts(std::span(&scene, 1), std::span(&search->contacts, 1), graph_);
+      builder.build_with_contacts(std::span(&scene, 1), std::span(&search->contacts, 1), graph);
     } else if (candidates) {
-      builder_.build_with_candidates(s, pairs, graph_);
+      builder.build_with_candidates(s, pairs, graph);
     } else {
-      builder_.build(s, graph_);
+      builder.build(s, graph);
     }
   };
   if (!omit) {
@@ -133,7 +189,7 @@ void ModelPredictor::predict_objects(const Scene& scene,
     return;
   }
   if (kept_.objects.empty()) {
-    build(kept_);  // nothing for the network: last_graph() says so
+    build(kept_, builder_, graph_);  // nothing for the network: last_graph() says so
     kept_accelerations_.resize(0, 3);
   } else {
     predict_averaged(kept_, build, kept_accelerations_);
@@ -148,14 +204,20 @@ void ModelPredictor::run_network(const Scene& scene, Points& accelerations) {
   // Eigen's thread count is process-wide: set ours for the forward pass, then give it back.
   const int previous = Eigen::nbThreads();
   if (options_.threads > 0) Eigen::setNbThreads(options_.threads);
-  const ConstMatrixView normalized = model_->network().forward(
-      model_->parameters().data(), model_->normalizers(), graph_, workspace_, false);
+  run_network_on(scene, graph_, workspace_, denormalized_, accelerations);
   Eigen::setNbThreads(previous);
+}
+
+void ModelPredictor::run_network_on(const Scene& scene, const Graph& graph,
+                                    NetworkWorkspace& workspace, RowMatrixXf& denormalized,
+                                    Points& accelerations) const {
+  const ConstMatrixView normalized = model_->network().forward(
+      model_->parameters().data(), model_->normalizers(), graph, workspace, false);
   // The scene's objects come first in the graph; a mesh floor's nodes follow and are dropped.
   const Eigen::Index n = scene.num_nodes();
-  denormalized_.resize(n, 3);
-  model_->normalizers().target.denormalize(normalized.topRows(n), denormalized_);
-  accelerations = denormalized_.cast<double>();
+  denormalized.resize(n, 3);
+  model_->normalizers().target.denormalize(normalized.topRows(n), denormalized);
+  accelerations = denormalized.cast<double>();
 }
 
 void GravityPredictor::predict(const Scene& scene, Points& accelerations) {

@@ -104,8 +104,9 @@ struct FIGNetWorldOptions {
     options.energy_guard = false;
     return options;
   }
-  // Threads for the network's matrix products (see PredictionOptions; 0: every core). One keeps
-  // a step from stalling behind the host program's own threads.
+  // Threads for the network's matrix products, or with turns > 1 for the turned copies, one per
+  // thread (see PredictionOptions; 0: every core). One keeps a step from stalling behind the host
+  // program's own threads.
   int threads = 1;
   // Predictions averaged over the scene turned by k/turns of a turn about the vertical (see
   // PredictionOptions::turns): cancels the model's own sideways push on resting bodies, at

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <memory>
 #include <span>
 
@@ -47,9 +48,10 @@ class AccelerationPredictor {
 
 // How a ModelPredictor runs its model.
 struct PredictionOptions {
-  // Threads for Eigen's matrix products (0: Eigen's default, every core). One by default: a
-  // step's products are small, and threads that wait for a core another program holds stall
-  // each product by a scheduler time slice, which made steps many times slower on a busy machine.
+  // Threads for Eigen's matrix products, or with turns > 1 for the turned copies, one per thread
+  // (0: Eigen's default, every core). One by default: a step's products are small, and threads
+  // that wait for a core another program holds stall each product by a scheduler time slice,
+  // which made steps many times slower on a busy machine.
   int threads = 1;
   // Predict the scene `turns` times, turned by k/turns of a full turn about the vertical
   // (k = 0 … turns − 1), and average the predictions turned back. True accelerations turn with
@@ -57,7 +59,9 @@ struct PredictionOptions {
   // accelerations the model adds whatever the scene's heading: trained models carry a bias of
   // ~0.15 mm/step² in a direction of their own (docs/training-study.md) that slides resting
   // bodies sideways. 2 (a half turn) cancels a constant bias; 4 also what changes with the
-  // heading as cos θ or sin θ. Costs `turns` predictions; 1: off.
+  // heading as cos θ or sin θ. Costs `turns` predictions; 1: off. With threads other than 1
+  // the turned copies run on separate threads, one copy per thread, each on one thread's
+  // products: a one-scene step's products are too small to share well.
   int turns = 1;
   // Present the network the scene's dynamic masses times one common factor, the one nearest 1
   // that brings them within the model's training masses (ModelConfig::min_mass, max_mass; a scene
@@ -124,11 +128,29 @@ class ModelPredictor : public AccelerationPredictor {
   const GraphBuilder& builder() const { return builder_; }
 
  private:
+  // What one turned copy of the scene needs of its own when the copies run on separate threads.
+  struct TurnedCopy {
+    explicit TurnedCopy(const GraphConfig& config) : builder(config) {}
+    Scene scene;
+    GraphBuilder builder;
+    Graph graph;
+    NetworkWorkspace workspace;
+    RowMatrixXf denormalized;
+    Points accelerations;
+  };
   // Runs the network on graph_ and un-normalises the scene's node rows.
   void run_network(const Scene& scene, Points& accelerations);
+  // The same on a given graph and workspace, on the calling thread's share of the products.
+  void run_network_on(const Scene& scene, const Graph& graph, NetworkWorkspace& workspace,
+                      RowMatrixXf& denormalized, Points& accelerations) const;
+  // Threads the turned copies may run on at once (1: one after another).
+  int turn_threads() const;
   // Builds the graph with `build`, runs the network and, with turns > 1, averages over turns.
   template <typename Build>
   void predict_averaged(const Scene& scene, Build&& build, Points& accelerations);
+  // predict_averaged's turns on turn_threads() threads, one copy per thread at a time.
+  template <typename Build>
+  void predict_turns_in_parallel(const Scene& scene, Build& build, Points& accelerations);
   // The scene the network sees: `scene` itself, or its copy with fitted masses (fit_masses).
   const Scene& with_fitted_masses(const Scene& scene);
   // A contact search the caller made (predict_with_search).
@@ -150,6 +172,8 @@ class ModelPredictor : public AccelerationPredictor {
   RowMatrixXf denormalized_;
   Scene turned_, mass_fitted_;
   Points turned_accelerations_, turned_sum_;
+  std::vector<std::unique_ptr<TurnedCopy>> copies_;  // turns − 1 of them, when turn_threads() > 1
+  std::vector<std::exception_ptr> copy_errors_;      // what each copy's thread threw
   FreeFlightSplit free_flight_;
   Scene kept_;                   // the scene's objects with a collision edge (omit_free_flight)
   SceneContacts kept_contacts_;  // and their collision pairs, as the split's search found them
