@@ -60,18 +60,11 @@ void ModelPredictor::predict_averaged(const Scene& scene, Build&& build, Points&
   }
   // The turned scenes first, so that last_graph() is the scene's own.
   for (int k = 1; k < options_.turns; ++k) {
-    const double angle = 2.0 * std::numbers::pi * k / options_.turns;
     turned_ = scene;  // copy-assigned: a steady-state step reuses the last one's buffers
-    turn_about_vertical(angle, turned_);
+    turn_about_vertical(turn_angle(k), turned_);
     build(turned_, builder_, graph_);
     run_network(turned_, turned_accelerations_);
-    // Row vectors turned by a ↦ a·Rᵀ turn back by a ↦ a·R.
-    const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, Vec3::UnitZ()).toRotationMatrix();
-    if (k == 1) {
-      turned_sum_.noalias() = turned_accelerations_ * turn;
-    } else {
-      turned_sum_.noalias() += turned_accelerations_ * turn;
-    }
+    add_turned_back(k, turned_accelerations_);
   }
   build(scene, builder_, graph_);
   run_network(scene, accelerations);
@@ -97,7 +90,7 @@ void ModelPredictor::predict_turns_in_parallel(const Scene& scene, Build& build,
       } else {
         TurnedCopy& copy = *copies_[k - 1];
         copy.scene = scene;  // copy-assigned: a steady-state step reuses the last one's buffers
-        turn_about_vertical(2.0 * std::numbers::pi * k / turns, copy.scene);
+        turn_about_vertical(turn_angle(k), copy.scene);
         build(copy.scene, copy.builder, copy.graph);
         run_network_on(copy.scene, copy.graph, copy.workspace, copy.denormalized,
                        copy.accelerations);
@@ -113,16 +106,22 @@ void ModelPredictor::predict_turns_in_parallel(const Scene& scene, Build& build,
     std::rethrow_exception(first);
   }
   // Turned back and summed in the order of the one-thread path, so both give the same sums.
-  for (int k = 1; k < turns; ++k) {
-    const double angle = 2.0 * std::numbers::pi * k / turns;
-    const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, Vec3::UnitZ()).toRotationMatrix();
-    if (k == 1) {
-      turned_sum_.noalias() = copies_[k - 1]->accelerations * turn;
-    } else {
-      turned_sum_.noalias() += copies_[k - 1]->accelerations * turn;
-    }
-  }
+  for (int k = 1; k < turns; ++k) add_turned_back(k, copies_[k - 1]->accelerations);
   accelerations = (accelerations + turned_sum_) / turns;
+}
+
+double ModelPredictor::turn_angle(int k) const {
+  return 2.0 * std::numbers::pi * k / options_.turns;
+}
+
+void ModelPredictor::add_turned_back(int k, const Points& turned) {
+  // Row vectors turned by a ↦ a·Rᵀ turn back by a ↦ a·R.
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(turn_angle(k), Vec3::UnitZ()).toRotationMatrix();
+  if (k == 1) {
+    turned_sum_.noalias() = turned * turn;
+  } else {
+    turned_sum_.noalias() += turned * turn;
+  }
 }
 
 const Scene& ModelPredictor::with_fitted_masses(const Scene& scene) {

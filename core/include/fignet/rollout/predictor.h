@@ -145,6 +145,10 @@ class ModelPredictor : public AccelerationPredictor {
                       RowMatrixXf& denormalized, Points& accelerations) const;
   // Threads the turned copies may run on at once (1: one after another).
   int turn_threads() const;
+  // Turned copy k's angle about the vertical: k/turns of a full turn.
+  double turn_angle(int k) const;
+  // Adds turned copy k's accelerations, turned back, to turned_sum_ (copy 1 starts it).
+  void add_turned_back(int k, const Points& turned);
   // Builds the graph with `build`, runs the network and, with turns > 1, averages over turns.
   template <typename Build>
   void predict_averaged(const Scene& scene, Build&& build, Points& accelerations);
