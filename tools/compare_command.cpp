@@ -28,6 +28,7 @@ struct CompareArgs {
   std::vector<fs::path> models;
   fs::path data, report = "fignet-report.html", json;
   int max_scenes = 5, frames = -1, threads = 1, turns = 1;
+  bool mirror = false;
 };
 
 void print_table(const std::vector<bullet::RunResult>& results) {
@@ -101,6 +102,7 @@ void run_compare(const CompareArgs& args) {
   for (bullet::ComparisonRun& run : runs) {
     run.world_options.threads = args.threads;
     run.world_options.turns = args.turns;
+    run.world_options.mirror = args.mirror;
   }
   ProgressBar progress("compare", static_cast<long long>(runs.size() * scenes.size()));
   const std::vector<bullet::RunResult> results =
@@ -162,6 +164,9 @@ void add_compare_command(CLI::App& app) {
                   "vertical (FIGNetWorldOptions::turns; turns times the network's cost)")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
+  cmd->add_flag("--mirror", args->mirror,
+                "Average with the scene seen in a mirror too, at each turn (FIGNetWorldOptions::"
+                "mirror; twice --turns' cost)");
   cmd->callback([args] { run_compare(*args); });
 }
 

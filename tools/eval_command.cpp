@@ -30,7 +30,7 @@ struct EvalArgs {
   std::vector<fs::path> models, data;
   fs::path json;
   int frames = -1, max_trajectories = -1, threads = 1, turns = 1;
-  bool free_flight = false;
+  bool free_flight = false, mirror = false;
   bool baseline = true, penetration = true, regimes = true;
 };
 
@@ -253,8 +253,10 @@ void run_eval(const EvalArgs& args) {
                                     file.string(), config.time_step, test[0].time_step));
     }
     history = config.graph.history;
-    ModelPredictor predictor(
-        model, {.threads = args.threads, .turns = args.turns, .free_flight = args.free_flight});
+    ModelPredictor predictor(model, {.threads = args.threads,
+                                     .turns = args.turns,
+                                     .mirror = args.mirror,
+                                     .free_flight = args.free_flight});
     const std::string name = file.filename().string() + (args.free_flight ? ", free flight" : "");
     rows.push_back(evaluate(name, kind_of(config), predictor, test, args));
     if (args.regimes) {
@@ -345,6 +347,9 @@ void add_eval_command(CLI::App& app) {
                   "vertical (PredictionOptions::turns; turns times the cost)")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
+  cmd->add_flag("--mirror", args->mirror,
+                "Average with the scene seen in a mirror too, at each turn (PredictionOptions::"
+                "mirror; twice --turns' cost)");
   cmd->add_flag("--free-flight", args->free_flight,
                 "Move bodies without a collision edge in free flight, outside the network, as "
                 "FIGNetDynamicsWorld does (PredictionOptions::free_flight; always so for a model "

@@ -27,6 +27,7 @@ struct StressArgs {
   std::vector<std::string> only;
   double length = 1.0;
   int turns = 1;
+  bool mirror = false;
   std::string command_line;
 };
 
@@ -87,7 +88,8 @@ void run_stress(const StressArgs& args) {
   for (const fs::path& file : args.models) {
     models.emplace_back(file.filename().string(), std::make_shared<const Model>(load_model(file)));
   }
-  const std::vector<bullet::Simulator> sims = bullet::stress_simulators(models, args.turns);
+  const std::vector<bullet::Simulator> sims =
+      bullet::stress_simulators(models, args.turns, 1, args.mirror);
   const std::vector<bullet::StressCase> cases = bullet::select_stress_cases(args.only, args.length);
 
   std::string table =
@@ -173,12 +175,16 @@ void add_stress_command(CLI::App& app) {
                   "vertical: cancels the model's sideways push at rest, at turns times the cost")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
+  cmd->add_flag("--mirror", args->mirror,
+                "Average with the scene seen in a mirror too, at each turn: cancels errors with a "
+                "handedness, at twice --turns' cost");
   cmd->callback([args] {
     std::string line = "build/release/tools/fignet stress";
     for (const fs::path& m : args->models) line += " --model " + m.string();
     for (const std::string& only : args->only) line += " --case '" + only + "'";
     if (args->length != 1.0) line += fmt::format(" --length {}", args->length);
     if (args->turns != 1) line += fmt::format(" --turns {}", args->turns);
+    if (args->mirror) line += " --mirror";
     if (!args->markdown.empty()) line += " --markdown " + args->markdown.string();
     args->command_line = line;
     run_stress(*args);

@@ -1108,6 +1108,7 @@ FIGNetDynamicsWorld::FIGNetDynamicsWorld(btDispatcher* dispatcher,
                           std::make_unique<ModelPredictor>(
                               model, PredictionOptions{.threads = options.threads,
                                                        .turns = options.turns,
+                                                       .mirror = options.mirror,
                                                        .fit_masses = options.fit_masses}),
                           model->config().graph, model->config().time_step, model->config().gravity,
                           with_model_budget(options, model->config())) {

@@ -345,7 +345,7 @@ std::vector<StressCase> select_stress_cases(const std::vector<std::string>& filt
 
 std::vector<Simulator> stress_simulators(
     const std::vector<std::pair<std::string, std::shared_ptr<const Model>>>& models, int turns,
-    int world_threads) {
+    int world_threads, bool mirror) {
   std::vector<Simulator> sims;
   sims.push_back({"Bullet 240 Hz", {}, {}});
   for (const auto& [name, model] : models) {
@@ -357,9 +357,11 @@ std::vector<Simulator> stress_simulators(
       FIGNetWorldOptions options =
           alone ? FIGNetWorldOptions::network_alone() : FIGNetWorldOptions{};
       options.turns = turns;
+      options.mirror = mirror;
       options.threads = world_threads;
       std::string variant = alone ? "network alone" : "";
       if (turns > 1) variant += fmt::format("{}{} turns", variant.empty() ? "" : ", ", turns);
+      if (mirror) variant += fmt::format("{}mirrored", variant.empty() ? "" : ", ");
       if (!variant.empty()) variant = " (" + variant + ")";
       sims.push_back({fmt::format("FIGNet {}{}", name, variant), one_step,
                       [shared, options](btDispatcher* d, btBroadphaseInterface* b,

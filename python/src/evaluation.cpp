@@ -107,10 +107,10 @@ angle (degrees); their means over frames first_predicted … end and their last 
   m.def(
       "evaluate",
       [](const std::shared_ptr<Model>& model, const std::vector<Trajectory>& trajectories,
-         int frames, bool penetration, int threads, int turns) {
+         int frames, bool penetration, int threads, int turns, bool mirror) {
         if (trajectories.empty()) throw py::value_error("evaluate: no trajectories");
         for (const Trajectory& t : trajectories) t.validate();
-        const PredictionOptions prediction{.threads = 1, .turns = turns};
+        const PredictionOptions prediction{.threads = 1, .turns = turns, .mirror = mirror};
         prediction.validate();  // here, not in the worker threads
         EvaluationOptions options;
         options.frames = frames;
@@ -143,8 +143,9 @@ angle (degrees); their means over frames first_predicted … end and their last 
       },
       py::arg("model"), py::arg("trajectories"), py::arg("frames") = -1,
       py::arg("penetration") = false, py::arg("threads") = 1, py::arg("turns") = 1,
+      py::arg("mirror") = false,
       R"(Rolls every trajectory out with the network alone and summarises as `fignet eval --json`
-does (the same keys; `turns` as its --turns): mean and last-frame errors averaged over trajectories, per-frame means,
+does (the same keys; `turns` and `mirror` as its --turns and --mirror): mean and last-frame errors averaged over trajectories, per-frame means,
 penetration ratios when asked (costly), and each trajectory's errors.)");
   m.def(
       "compare_paired",

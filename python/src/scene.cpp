@@ -30,7 +30,7 @@ class PyScene {
  public:
   PyScene(std::shared_ptr<Model> model, bool free_flight, bool sleeping, bool penetration_guard,
           bool sweep_guard, int threads, std::optional<int> graph_vertices, bool rest_guard,
-          int turns, bool energy_guard, bool seed_falling)
+          int turns, bool energy_guard, bool seed_falling, bool mirror)
       : model_(std::move(model)) {
     // Checked now: the world, and with it the predictor, is made at the first step.
     PredictionOptions{.turns = turns}.validate();
@@ -44,6 +44,7 @@ class PyScene {
     options_.seed_falling = seed_falling;
     options_.threads = threads;
     options_.turns = turns;
+    options_.mirror = mirror;
     if (model_) {
       // Frames at the model's step, Bullet's 240 Hz substeps for the native reference.
       spec_.gravity = model_->config().gravity;
@@ -266,17 +267,18 @@ the network alone, as `fignet eval` measures it. A mesh finer than the model was
 `graph_vertices` (default None: the model's own resolution, 64 for MOVi-A; 0: never) within 2 %
 of its size; Bullet still collides the full mesh. `turns` > 1 predicts each frame that
 many times, the scene turned by k/turns of a turn about the vertical, and averages: it cancels the
-sideways push a model gives resting bodies, at `turns` times the cost. A body added in free
+sideways push a model gives resting bodies, at `turns` times the cost; `mirror` averages with
+the scene seen in a mirror too, at each turn (twice the cost). A body added in free
 flight starts on its gravity's parabola, as bodies in the training data moved (seed_falling;
 False: moving straight at its velocity, which falls g·dt²/2 too far in the first step). Without a
 model, native Bullet steps at 240 Hz, 5 substeps per frame.)")
       .def(py::init<std::shared_ptr<Model>, bool, bool, bool, bool, int, std::optional<int>, bool,
-                    int, bool, bool>(),
+                    int, bool, bool, bool>(),
            py::arg("model") = py::none(), py::arg("free_flight") = true, py::arg("sleeping") = true,
            py::arg("penetration_guard") = true, py::arg("sweep_guard") = true,
            py::arg("threads") = 1, py::arg("graph_vertices") = py::none(),
            py::arg("rest_guard") = true, py::arg("turns") = 1, py::arg("energy_guard") = true,
-           py::arg("seed_falling") = true)
+           py::arg("seed_falling") = true, py::arg("mirror") = false)
       .def(
           "add_body",
           [](PyScene& scene, const py::handle& vertices, const py::handle& faces,

@@ -3,7 +3,9 @@
 #include <cmath>
 
 #include "fignet/error.h"
+#include "fignet/geometry/mass_properties.h"
 #include "fignet/geometry/mesh.h"
+#include "fignet/geometry/shapes.h"
 
 namespace fignet {
 namespace {
@@ -50,6 +52,36 @@ TEST(TriangleMesh, OpenAndInconsistentMeshesAreNotClosed) {
   Triangles flipped = tetrahedron_faces();
   flipped.row(3) << 1, 3, 2;
   EXPECT_FALSE(TriangleMesh("flipped", tetrahedron_vertices(), flipped).is_closed());
+}
+
+TEST(TriangleMesh, MirroredMeshIsTheReflectedSolidWithOutwardNormals) {
+  // A torus knot has a handedness: its mirror is another solid, of the same volume, with the
+  // reflected centre of mass and inertia (M·I·M for the reflection M), face for face. Tilted and
+  // moved off the origin, so that neither has a zero the reflection would leave as it is.
+  const TriangleMesh upright = make_torus_knot(2, 3, 1.0, 0.2, 48, 8);
+  const Eigen::Matrix3d tilt =
+      Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  Points tilted = upright.vertices() * tilt.transpose();
+  tilted.rowwise() += Eigen::RowVector3d(0.1, 0.2, 0.3);
+  const TriangleMesh knot("knot", tilted, upright.faces());
+  const TriangleMesh mirror = mirrored_mesh(knot);
+  const Eigen::DiagonalMatrix<double, 3> reflect(1.0, -1.0, 1.0);
+  ASSERT_EQ(mirror.num_vertices(), knot.num_vertices());
+  ASSERT_EQ(mirror.num_faces(), knot.num_faces());
+  EXPECT_TRUE((mirror.vertices() - knot.vertices() * reflect).isZero(0.0));
+  EXPECT_TRUE((mirror.face_normals() - knot.face_normals() * reflect).isZero(1e-12));
+  EXPECT_TRUE((mirror.edges() - knot.edges()).isZero());
+  EXPECT_TRUE(mirror.is_closed());
+  const MassProperties a = compute_mass_properties(knot), b = compute_mass_properties(mirror);
+  EXPECT_NEAR(b.volume, a.volume, 1e-12 * a.volume);
+  EXPECT_TRUE(b.center_of_mass.isApprox(reflect * a.center_of_mass, 1e-9));
+  const Eigen::Matrix3d reflected_inertia = reflect * a.inertia * reflect;
+  EXPECT_TRUE(b.inertia.isApprox(reflected_inertia, 1e-9));
+  EXPECT_GT(std::abs(a.inertia(0, 1)), 1e-3 * a.inertia.norm());  // the reflection changes it
+  // The mirror's mirror is the mesh itself.
+  const TriangleMesh back = mirrored_mesh(mirror);
+  EXPECT_TRUE((back.vertices() - knot.vertices()).isZero(0.0));
+  EXPECT_TRUE((back.faces() - knot.faces()).isZero());
 }
 
 TEST(TriangleMesh, RejectsNonFiniteVertexNamingIt) {

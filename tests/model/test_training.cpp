@@ -898,10 +898,53 @@ TEST(ModelPredictor, PredictionsAveragedOverTurnsTurnWithTheScene) {
   EXPECT_LT(turned_prediction_difference(four, in_air.scene, half), 1e-5);
 }
 
+// `scene` seen in a mirror through the plane y = 0 (its floor's centre lies on it), with the
+// mirrored meshes it needs.
+struct MirroredScene {
+  std::vector<std::unique_ptr<const TriangleMesh>> meshes;
+  Scene scene;
+};
+
+MirroredScene mirror_of(const Scene& scene) {
+  MirroredScene result;
+  result.scene = scene;
+  map_about_vertical(Eigen::Vector3d(1.0, -1.0, 1.0).asDiagonal().toDenseMatrix(), result.scene);
+  for (SceneObject& object : result.scene.objects) {
+    result.meshes.push_back(std::make_unique<const TriangleMesh>(mirrored_mesh(*object.mesh)));
+    object.mesh = result.meshes.back().get();
+  }
+  return result;
+}
+
+TEST(ModelPredictor, PredictionsAveragedWithTheMirrorReflectWithTheScene) {
+  // Averaged with the mirrored scene's, a prediction is equivariant to the reflection whatever
+  // the weights, and with turns to the turns as well; a single one is neither.
+  const auto fixture = testing::make_random_scene(17, 5, 2.0);
+  auto model = random_model(fixture.scene);
+  const MirroredScene mirrored = mirror_of(fixture.scene);
+  const Eigen::Matrix3d reflect = Eigen::Vector3d(1.0, -1.0, 1.0).asDiagonal();
+  auto reflected_difference = [&](ModelPredictor& predictor) {
+    Points direct, image;
+    predictor.predict(fixture.scene, direct);
+    predictor.predict(mirrored.scene, image);
+    return (image * reflect - direct).cwiseAbs().maxCoeff() / direct.cwiseAbs().maxCoeff();
+  };
+  ModelPredictor single(model), mirror(model, {.mirror = true}),
+      four_mirrored(model, {.turns = 4, .mirror = true});
+  EXPECT_GT(reflected_difference(single), 1e-2);
+  EXPECT_GT(single.last_face_edges(), 0);
+  EXPECT_LT(reflected_difference(mirror), 1e-5);
+  EXPECT_LT(reflected_difference(four_mirrored), 1e-5);
+  EXPECT_LT(turned_prediction_difference(four_mirrored, fixture.scene, std::numbers::pi / 2), 1e-5);
+  // The mirrored copy is no turn: turns alone leave the reflection's difference.
+  ModelPredictor two(model, {.turns = 2});
+  EXPECT_GT(reflected_difference(two), 1e-2);
+}
+
 TEST(ModelPredictor, TurnedCopiesOnSeveralThreadsPredictAsOnOne) {
-  // With threads other than 1 the turned copies run one per thread, each on its own builder,
-  // graph and workspace: the same predictions as one after another (products on one thread each
-  // against products shared out: float tolerance), and last_graph() still the scene's own, for
+  // With threads other than 1 the turned (and mirrored) copies run one per thread, each on its own
+  // builder, graph and workspace: the same predictions as one after another (products on one thread
+  // each against products shared out: float tolerance), and last_graph() still the scene's own, for
   // the plain build, Bullet's candidate pairs and the free-flight split.
   const auto fixture = testing::make_random_scene(13, 5, 2.0);
   auto model = random_model(fixture.scene);
@@ -910,11 +953,14 @@ TEST(ModelPredictor, TurnedCopiesOnSeveralThreadsPredictAsOnOne) {
   for (int a = 0; a < n; ++a) {
     for (int b = a + 1; b < n; ++b) all_pairs.push_back({a, b});
   }
-  for (const bool free_flight : {false, true}) {
+  for (const auto& [free_flight, mirror] :
+       {std::pair(false, false), {true, false}, {false, true}}) {
     for (const bool with_candidates : {false, true}) {
-      SCOPED_TRACE(::testing::Message()
-                   << "free_flight " << free_flight << ", candidates " << with_candidates);
-      ModelPredictor one(model, {.threads = 1, .turns = 4, .free_flight = free_flight});
+      SCOPED_TRACE(::testing::Message() << "free_flight " << free_flight << ", mirror " << mirror
+                                        << ", candidates " << with_candidates);
+      const PredictionOptions options{
+          .threads = 1, .turns = 4, .mirror = mirror, .free_flight = free_flight};
+      ModelPredictor one(model, options);
       Points expected, predicted;
       auto predict = [&](ModelPredictor& predictor, Points& out) {
         if (with_candidates) {
@@ -925,7 +971,9 @@ TEST(ModelPredictor, TurnedCopiesOnSeveralThreadsPredictAsOnOne) {
       };
       predict(one, expected);
       for (const int threads : {2, 3}) {
-        ModelPredictor several(model, {.threads = threads, .turns = 4, .free_flight = free_flight});
+        PredictionOptions on_threads = options;
+        on_threads.threads = threads;
+        ModelPredictor several(model, on_threads);
         for (int step = 0; step < 2; ++step) {  // the second reuses every copy's buffers
           predict(several, predicted);
           ASSERT_EQ(predicted.rows(), expected.rows());

@@ -45,6 +45,25 @@ def test_evaluation_equals_fignet_eval_on_the_same_file(tmp_path, cli, model, so
     assert abs(travel - run["travel_ratio"]) <= 1e-9
 
 
+def test_averaged_evaluation_equals_fignet_eval_with_the_same_turns_and_mirror(
+        tmp_path, cli, model, source_dir):
+    data = tmp_path / "scenes.h5"
+    truths = fignet.generate("movi-a", count=2, seed=21, frames=12, path=data)
+    report = tmp_path / "eval.json"
+    subprocess.run(
+        [cli, "eval", "--model", source_dir / "models" / "movi-a-small.h5", "--data", data,
+         "--threads", "1", "--turns", "2", "--mirror", "--json", report],
+        check=True, capture_output=True,
+    )
+    (run,) = [r for r in json.loads(report.read_text())["runs"] if r["name"] != "ballistic"]
+    averaged = fignet.evaluate(model, truths, turns=2, mirror=True)
+    plain = fignet.evaluate(model, truths)
+    for key in ("mean_translation_m", "mean_rotation_deg"):
+        assert abs(averaged[key] - run[key]) <= 1e-9 * max(1.0, abs(run[key])), key
+    # Four predictions a step averaged are not the one: the options reached the predictor.
+    assert abs(averaged["mean_translation_m"] - plain["mean_translation_m"]) > 1e-6
+
+
 def test_rollouts_keep_the_given_frames_and_match_one_step_predictions(model):
     (truth,) = fignet.generate("movi-a", count=1, seed=8, frames=12)
     predicted = fignet.rollout(model, truth, given_frames=5, frames=10)

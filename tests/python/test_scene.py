@@ -197,5 +197,13 @@ def test_turn_averaging_cancels_the_models_sideways_push_at_rest(model):
         moved[turns] = np.linalg.norm(ends[turns][:2] - start[:2])
     assert np.linalg.norm(ends[2] - ends[1]) > 1e-6, ends
     assert moved[2] < 0.8 * moved[1], moved
+    # The mirror (FIGNetWorldOptions::mirror; its reflection equivariance is tested in C++)
+    # reaches the predictor too: the same run with it ends elsewhere.
+    scene = fignet.Scene(model, free_flight=False, sleeping=False, penetration_guard=False,
+                         rest_guard=False, mirror=True)
+    scene.add_floor()
+    scene.add_body(vertices, faces, mass=7.4, friction=0.4, restitution=0.3, position=start)
+    scene.step(192)
+    assert np.linalg.norm(scene.positions[0] - ends[1]) > 1e-7
     with pytest.raises(ValueError, match="turns"):
         fignet.Scene(model, turns=0).step(1)

@@ -128,6 +128,15 @@ TriangleMesh mesh_of_used_vertices(std::string name, const Points& vertices,
   return TriangleMesh(std::move(name), std::move(kept), std::move(triangles), options);
 }
 
+TriangleMesh mirrored_mesh(const TriangleMesh& mesh) {
+  Points vertices = mesh.vertices();
+  vertices.col(1) = -vertices.col(1);
+  // A reflection turns right-handed windings left-handed: swapping two corners turns them back.
+  Triangles faces = mesh.faces();
+  faces.col(1).swap(faces.col(2));
+  return TriangleMesh(mesh.name() + " (mirrored)", std::move(vertices), std::move(faces));
+}
+
 bool TriangleMesh::is_closed() const {
   // Each directed half-edge must appear once, and its twin (reversed) exactly once.
   std::map<std::pair<std::int32_t, std::int32_t>, int> half_edges;

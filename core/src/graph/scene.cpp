@@ -39,21 +39,23 @@ void set_pose_history(SceneObject& object, std::span<const Pose> poses,
 }
 
 void turn_about_vertical(double angle, Scene& scene) {
-  const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, Vec3::UnitZ()).toRotationMatrix();
+  map_about_vertical(Eigen::AngleAxisd(angle, Vec3::UnitZ()).toRotationMatrix(), scene);
+}
+
+void map_about_vertical(const Eigen::Matrix3d& map, Scene& scene) {
   const Vec3 axis =
       scene.floor ? Vec3(scene.floor->center_x, scene.floor->center_y, 0.0) : Vec3::Zero();
-  // Row vectors turn by p ↦ axis + R·(p − axis), i.e. (p − axis)·Rᵀ + axis.
-  auto turn_points = [&](Points& points) {
+  // Row vectors map by p ↦ axis + M·(p − axis), i.e. (p − axis)·Mᵀ + axis.
+  auto map_points = [&](Points& points) {
     if (points.rows() == 0) return;
-    points =
-        ((points.rowwise() - axis.transpose()) * turn.transpose()).rowwise() + axis.transpose();
+    points = ((points.rowwise() - axis.transpose()) * map.transpose()).rowwise() + axis.transpose();
   };
   for (SceneObject& object : scene.objects) {
-    turn_points(object.positions);
-    turn_points(object.centers);
+    map_points(object.positions);
+    map_points(object.centers);
     if (object.kinematic) {
-      turn_points(object.next_positions);
-      object.next_center = axis + turn * (object.next_center - axis);
+      map_points(object.next_positions);
+      object.next_center = axis + map * (object.next_center - axis);
     }
   }
 }

@@ -49,48 +49,48 @@ ModelPredictor::ModelPredictor(std::shared_ptr<const Model> model, const Predict
 
 int ModelPredictor::turn_threads() const {
   const int threads = options_.threads > 0 ? options_.threads : Eigen::nbThreads();
-  return std::min(threads, options_.turns);
+  return std::min(threads, options_.copies());
 }
 
 template <typename Build>
 void ModelPredictor::predict_averaged(const Scene& scene, Build&& build, Points& accelerations) {
-  if (options_.turns > 1 && turn_threads() > 1) {
+  const int copies = options_.copies();
+  if (options_.mirror) update_mirrors(scene);
+  if (copies > 1 && turn_threads() > 1) {
     predict_turns_in_parallel(scene, build, accelerations);
     return;
   }
-  // The turned scenes first, so that last_graph() is the scene's own.
-  for (int k = 1; k < options_.turns; ++k) {
-    turned_ = scene;  // copy-assigned: a steady-state step reuses the last one's buffers
-    turn_about_vertical(turn_angle(k), turned_);
+  // The turned and mirrored scenes first, so that last_graph() is the scene's own.
+  for (int k = 1; k < copies; ++k) {
+    make_copy(k, scene, turned_);
     build(turned_, builder_, graph_);
     run_network(turned_, turned_accelerations_);
     add_turned_back(k, turned_accelerations_);
   }
   build(scene, builder_, graph_);
   run_network(scene, accelerations);
-  if (options_.turns > 1) accelerations = (accelerations + turned_sum_) / options_.turns;
+  if (copies > 1) accelerations = (accelerations + turned_sum_) / copies;
 }
 
 template <typename Build>
 void ModelPredictor::predict_turns_in_parallel(const Scene& scene, Build& build,
                                                Points& accelerations) {
-  const int turns = options_.turns;
-  while (static_cast<int>(copies_.size()) < turns - 1) {
+  const int copies = options_.copies();
+  while (static_cast<int>(copies_.size()) < copies - 1) {
     copies_.push_back(std::make_unique<TurnedCopy>(model_->config().graph));
   }
-  copy_errors_.resize(turns);
+  copy_errors_.resize(copies);
   // Copy 0 is the scene itself, on the predictor's own builder and graph (last_graph()); inside
   // the parallel loop every product runs on its calling thread alone (gemm.h).
 #pragma omp parallel for num_threads(turn_threads()) schedule(dynamic, 1)
-  for (int k = 0; k < turns; ++k) {
+  for (int k = 0; k < copies; ++k) {
     try {
       if (k == 0) {
         build(scene, builder_, graph_);
         run_network_on(scene, graph_, workspace_, denormalized_, accelerations);
       } else {
         TurnedCopy& copy = *copies_[k - 1];
-        copy.scene = scene;  // copy-assigned: a steady-state step reuses the last one's buffers
-        turn_about_vertical(turn_angle(k), copy.scene);
+        make_copy(k, scene, copy.scene);
         build(copy.scene, copy.builder, copy.graph);
         run_network_on(copy.scene, copy.graph, copy.workspace, copy.denormalized,
                        copy.accelerations);
@@ -105,22 +105,66 @@ void ModelPredictor::predict_turns_in_parallel(const Scene& scene, Build& build,
     std::fill(copy_errors_.begin(), copy_errors_.end(), nullptr);
     std::rethrow_exception(first);
   }
-  // Turned back and summed in the order of the one-thread path, so both give the same sums.
-  for (int k = 1; k < turns; ++k) add_turned_back(k, copies_[k - 1]->accelerations);
-  accelerations = (accelerations + turned_sum_) / turns;
+  // Mapped back and summed in the order of the one-thread path, so both give the same sums.
+  for (int k = 1; k < copies; ++k) add_turned_back(k, copies_[k - 1]->accelerations);
+  accelerations = (accelerations + turned_sum_) / copies;
 }
 
-double ModelPredictor::turn_angle(int k) const {
-  return 2.0 * std::numbers::pi * k / options_.turns;
+Eigen::Matrix3d ModelPredictor::copy_map(int k) const {
+  const double angle = 2.0 * std::numbers::pi * (k % options_.turns) / options_.turns;
+  Eigen::Matrix3d map = Eigen::AngleAxisd(angle, Vec3::UnitZ()).toRotationMatrix();
+  if (k >= options_.turns) map.col(1) = -map.col(1);  // R·diag(1, −1, 1): reflect, then turn
+  return map;
+}
+
+void ModelPredictor::make_copy(int k, const Scene& scene, Scene& copy) const {
+  copy = scene;  // copy-assigned: a steady-state step reuses the last one's buffers
+  map_about_vertical(copy_map(k), copy);
+  if (k < options_.turns) return;
+  for (SceneObject& object : copy.objects) {
+    const auto mirror = std::find_if(mirrors_.begin(), mirrors_.end(),
+                                     [&](const auto& entry) { return entry.first == object.mesh; });
+    object.mesh = mirror->second.get();  // update_mirrors() has made one for every mesh
+  }
+}
+
+void ModelPredictor::update_mirrors(const Scene& scene) {
+  for (const SceneObject& object : scene.objects) {
+    const TriangleMesh& mesh = *object.mesh;
+    auto entry = std::find_if(mirrors_.begin(), mirrors_.end(),
+                              [&](const auto& e) { return e.first == &mesh; });
+    // A mesh freed and another made at its address is told apart by its vertices and faces.
+    const bool current = entry != mirrors_.end() &&
+                         entry->second->num_faces() == mesh.num_faces() &&
+                         entry->second->vertices().rows() == mesh.vertices().rows() &&
+                         entry->second->vertices().col(1) == -mesh.vertices().col(1) &&
+                         entry->second->vertices().col(0) == mesh.vertices().col(0) &&
+                         entry->second->vertices().col(2) == mesh.vertices().col(2);
+    if (current) continue;
+    auto mirror = std::make_unique<const TriangleMesh>(mirrored_mesh(mesh));
+    if (entry != mirrors_.end()) {
+      entry->second = std::move(mirror);
+    } else {
+      mirrors_.emplace_back(&mesh, std::move(mirror));
+    }
+  }
+  // Bodies come and go (a world's spawner): the mirrors of meshes no longer seen are let go once
+  // they outnumber the scene's own.
+  if (mirrors_.size() > 2 * scene.objects.size() + 16) {
+    std::erase_if(mirrors_, [&](const auto& entry) {
+      return std::none_of(scene.objects.begin(), scene.objects.end(),
+                          [&](const SceneObject& object) { return object.mesh == entry.first; });
+    });
+  }
 }
 
 void ModelPredictor::add_turned_back(int k, const Points& turned) {
-  // Row vectors turned by a ↦ a·Rᵀ turn back by a ↦ a·R.
-  const Eigen::Matrix3d turn = Eigen::AngleAxisd(turn_angle(k), Vec3::UnitZ()).toRotationMatrix();
+  // Row vectors mapped by a ↦ a·Mᵀ map back by a ↦ a·M (M orthogonal).
+  const Eigen::Matrix3d map = copy_map(k);
   if (k == 1) {
-    turned_sum_.noalias() = turned * turn;
+    turned_sum_.noalias() = turned * map;
   } else {
-    turned_sum_.noalias() += turned * turn;
+    turned_sum_.noalias() += turned * map;
   }
 }
 

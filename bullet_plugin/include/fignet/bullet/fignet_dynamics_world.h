@@ -112,6 +112,9 @@ struct FIGNetWorldOptions {
   // PredictionOptions::turns): cancels the model's own sideways push on resting bodies, at
   // `turns` times the network's cost. 1: off. Only for worlds built from a model.
   int turns = 1;
+  // Also average over the scene seen in a mirror, at each turn (PredictionOptions::mirror): at
+  // 2·turns times the network's cost. Only for worlds built from a model.
+  bool mirror = false;
   // The network sees the scene's masses times the common factor that brings them within its
   // training data's (PredictionOptions::fit_masses; only for worlds built from a model).
   bool fit_masses = true;

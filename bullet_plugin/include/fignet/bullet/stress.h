@@ -65,11 +65,12 @@ struct Simulator {
 
 // Native Bullet at 240 Hz and, per model, a FIGNet world stepping once per frame: the network
 // alone, then the world as users get it, both averaging over `turns` headings
-// (FIGNetWorldOptions::turns). `world_threads` is each world's FIGNetWorldOptions::threads: 0
-// leaves Eigen's process-wide setting alone, as worlds run side by side must.
+// (FIGNetWorldOptions::turns), and with `mirror` over their mirror images too. `world_threads` is
+// each world's FIGNetWorldOptions::threads: 0 leaves Eigen's process-wide setting alone, as
+// worlds run side by side must.
 std::vector<Simulator> stress_simulators(
     const std::vector<std::pair<std::string, std::shared_ptr<const Model>>>& models, int turns = 1,
-    int world_threads = 1);
+    int world_threads = 1, bool mirror = false);
 
 // Runs one case on each simulator (the first is the reference for `error`).
 std::vector<StressRun> run_stress_case(const StressCase& c, const std::vector<Simulator>& sims);

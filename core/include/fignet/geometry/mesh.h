@@ -64,6 +64,11 @@ class TriangleMesh {
 TriangleMesh mesh_of_used_vertices(std::string name, const Points& vertices,
                                    std::span<const std::array<int, 3>> faces);
 
+// The mesh seen in a mirror: its vertices reflected through its own y = 0 plane (y ↦ −y) and each
+// face's winding reversed, so that its normals point outward again. Vertex and face numbers are
+// kept, so per-vertex arrays of the two meshes correspond row by row.
+TriangleMesh mirrored_mesh(const TriangleMesh& mesh);
+
 // Unit normal of triangle (a, b, c) by the right-hand rule; zero for a degenerate triangle.
 Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c);
 

@@ -78,4 +78,11 @@ struct Scene {
 // the floor are unchanged by the turn, so the turned scene is as true as the original.
 void turn_about_vertical(double angle, Scene& scene);
 
+// Applies `map`, a turn about the vertical possibly after a reflection through a vertical plane
+// (an orthogonal 3×3 matrix that keeps +z), to every object's positions, centres and kinematic
+// next poses, about the vertical axis through the floor's centre (the origin when the scene has
+// no floor). The objects' meshes are left as they are: a reflected scene needs its bodies' meshes
+// mirrored too (mirrored_mesh), which the caller owns.
+void map_about_vertical(const Eigen::Matrix3d& map, Scene& scene);
+
 }  // namespace fignet

@@ -63,6 +63,12 @@ struct PredictionOptions {
   // the turned copies run on separate threads, one copy per thread, each on one thread's
   // products: a one-scene step's products are too small to share well.
   int turns = 1;
+  // Also predict the scene seen in a mirror, at each of the turns: reflected through the vertical
+  // plane y = const through the floor's centre, every body's mesh mirrored (mirrored_mesh), and
+  // the predictions reflected back into the average. Gravity, contact and friction act the same
+  // in a mirror, so a true prediction is unchanged; the model's errors that have a handedness
+  // (a spin it adds, a sideways slide at contact) cancel. Costs 2·turns predictions.
+  bool mirror = false;
   // Present the network the scene's dynamic masses times one common factor, the one nearest 1
   // that brings them within the model's training masses (ModelConfig::min_mass, max_mass; a scene
   // whose masses span more than those gets the factor that centres its span on theirs, in
@@ -79,6 +85,8 @@ struct PredictionOptions {
 
   // Throws ConfigError naming the field that is out of range.
   void validate() const;
+  // How many predictions each step averages: turns, twice that with mirror.
+  int copies() const { return mirror ? 2 * turns : turns; }
 };
 
 // The lightest and heaviest dynamic body seen, kg (kinematic and massless bodies left out: their
@@ -145,9 +153,15 @@ class ModelPredictor : public AccelerationPredictor {
                       RowMatrixXf& denormalized, Points& accelerations) const;
   // Threads the turned copies may run on at once (1: one after another).
   int turn_threads() const;
-  // Turned copy k's angle about the vertical: k/turns of a full turn.
-  double turn_angle(int k) const;
-  // Adds turned copy k's accelerations, turned back, to turned_sum_ (copy 1 starts it).
+  // Copy k's map of the scene (k < copies()): k mod turns of a turns-th of a full turn about the
+  // vertical, after a reflection y ↦ −y for the mirrored copies (k >= turns).
+  Eigen::Matrix3d copy_map(int k) const;
+  // Makes `copy` scene's copy k: the scene mapped by copy_map(k), with mirrored meshes for k >=
+  // turns (from mirrors_, which update_mirrors() has filled for the scene's meshes).
+  void make_copy(int k, const Scene& scene, Scene& copy) const;
+  // Makes mirrors_ hold the mirror of each of the scene's meshes (kept from step to step).
+  void update_mirrors(const Scene& scene);
+  // Adds copy k's accelerations, mapped back, to turned_sum_ (copy 1 starts it).
   void add_turned_back(int k, const Points& turned);
   // Builds the graph with `build`, runs the network and, with turns > 1, averages over turns.
   template <typename Build>
@@ -176,8 +190,10 @@ class ModelPredictor : public AccelerationPredictor {
   RowMatrixXf denormalized_;
   Scene turned_, mass_fitted_;
   Points turned_accelerations_, turned_sum_;
-  std::vector<std::unique_ptr<TurnedCopy>> copies_;  // turns − 1 of them, when turn_threads() > 1
-  std::vector<std::exception_ptr> copy_errors_;      // what each copy's thread threw
+  std::vector<std::unique_ptr<TurnedCopy>> copies_;  // copies() − 1, when turn_threads() > 1
+  // Each mesh of the scenes seen so far with its mirror, for the mirrored copies.
+  std::vector<std::pair<const TriangleMesh*, std::unique_ptr<const TriangleMesh>>> mirrors_;
+  std::vector<std::exception_ptr> copy_errors_;  // what each copy's thread threw
   FreeFlightSplit free_flight_;
   Scene kept_;                   // the scene's objects with a collision edge (omit_free_flight)
   SceneContacts kept_contacts_;  // and their collision pairs, as the split's search found them
