@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "commands.h"
+#include "device_option.h"
 #include "fignet/bullet/comparison.h"
 #include "fignet/error.h"
 #include "fignet/io/model_file.h"
@@ -28,20 +29,27 @@ struct CompareArgs {
   std::vector<fs::path> models;
   fs::path data, report = "fignet-report.html", json;
   int max_scenes = 5, frames = -1, threads = 1, turns = 1;
-  bool mirror = false;
+  bool mirror = false, bf16 = false;
 };
 
 void print_table(const std::vector<bullet::RunResult>& results) {
-  fmt::print("\n{:<48} {:>12} {:>9} {:>19} {:>19}\n", "", "speed", "", "translation (m)",
-             "rotation (deg)");
-  fmt::print("{:<48} {:>12} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "run", "ms/sim s", "x real", "mean",
-             "last", "mean", "last");
+  // The run column fits the longest name (a model's file name, its options, the run's kind).
+  std::vector<std::string> names;
+  size_t width = 48;
   for (const bullet::RunResult& r : results) {
+    names.push_back(fmt::format("{} ({})", r.run.name, r.run.kind));
+    width = std::max(width, names.back().size());
+  }
+  fmt::print("\n{:<{}} {:>12} {:>9} {:>19} {:>19}\n", "", width, "speed", "", "translation (m)",
+             "rotation (deg)");
+  fmt::print("{:<{}} {:>12} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "run", width, "ms/sim s", "x real",
+             "mean", "last", "mean", "last");
+  for (size_t k = 0; k < results.size(); ++k) {
+    const bullet::RunResult& r = results[k];
     const double realtime = 1000.0 / r.milliseconds_per_simulated_second;
-    fmt::print("{:<48} {:>12.2f} {:>9.1f} {:>9.4f} {:>9.4f} {:>9.2f} {:>9.2f}\n",
-               fmt::format("{} ({})", r.run.name, r.run.kind), r.milliseconds_per_simulated_second,
-               realtime, r.mean_translation, r.final_translation, r.mean_rotation,
-               r.final_rotation);
+    fmt::print("{:<{}} {:>12.2f} {:>9.1f} {:>9.4f} {:>9.4f} {:>9.2f} {:>9.2f}\n", names[k], width,
+               r.milliseconds_per_simulated_second, realtime, r.mean_translation,
+               r.final_translation, r.mean_rotation, r.final_rotation);
   }
   fmt::print(
       "\nErrors against the ground truth, every run started from the same first frame; x real: "
@@ -79,6 +87,7 @@ void print_against(const std::vector<bullet::RunResult>& results, const std::str
 }
 
 void run_compare(const CompareArgs& args) {
+  use_bf16_products(args.bf16);
   std::vector<Trajectory> recorded = read_trajectories(args.data);
   if (static_cast<int>(recorded.size()) > args.max_scenes) recorded.resize(args.max_scenes);
   std::vector<bullet::SceneSpec> scenes;
@@ -90,7 +99,7 @@ void run_compare(const CompareArgs& args) {
   std::vector<std::string> names;
   for (const fs::path& file : args.models) {
     models.push_back(std::make_shared<const Model>(load_model(file)));
-    names.push_back(file.filename().string());
+    names.push_back(file.filename().string() + (args.bf16 ? ", bf16 products" : ""));
     const double step = models.back()->config().time_step;
     if (std::abs(step - scenes[0].frame_step()) > 1e-9) {
       throw ConfigError(
@@ -164,6 +173,7 @@ void add_compare_command(CLI::App& app) {
                   "vertical (FIGNetWorldOptions::turns; turns times the network's cost)")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
+  add_bf16_option(*cmd, args->bf16);
   cmd->add_flag("--mirror", args->mirror,
                 "Average with the scene seen in a mirror too, at each turn (FIGNetWorldOptions::"
                 "mirror; twice --turns' cost)");

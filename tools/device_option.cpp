@@ -26,14 +26,23 @@ void add_device_options(CLI::App& cmd, DeviceArgs& args) {
                "operand rounded to 8 significant bits, sums in f32; see docs/network.md)");
 }
 
+void add_bf16_option(CLI::App& cmd, bool& bf16) {
+  cmd.add_flag("--bf16", bf16,
+               "bfloat16 matrix products (oneDNN on processors with AVX512-BF16 or AMX; each "
+               "operand rounded to 8 significant bits, sums in f32; see docs/network.md)");
+}
+
+void use_bf16_products(bool bf16) {
+  if (!bf16) return;
+  const std::string why_not = gemm_precision_unavailable(GemmPrecision::kBf16);
+  if (!why_not.empty()) throw ConfigError("--bf16: " + why_not + "; leave --bf16 out");
+  set_gemm_precision(GemmPrecision::kBf16);
+}
+
 std::unique_ptr<NetworkBackend> make_backend(const DeviceArgs& args, const Network& network) {
   if (args.device == "cpu") {
     if (args.tf32) throw ConfigError("--tf32 applies to --device cuda only");
-    if (args.bf16) {
-      const std::string why_not = gemm_precision_unavailable(GemmPrecision::kBf16);
-      if (!why_not.empty()) throw ConfigError("--bf16: " + why_not + "; leave --bf16 out");
-      set_gemm_precision(GemmPrecision::kBf16);
-    }
+    use_bf16_products(args.bf16);
     return nullptr;
   }
   if (args.bf16) {

@@ -23,4 +23,10 @@ void add_device_options(CLI::App& cmd, DeviceArgs& args);
 // ConfigError for an unknown device, or one or a precision this build or machine cannot use.
 std::unique_ptr<NetworkBackend> make_backend(const DeviceArgs& args, const Network& network);
 
+// `--bf16` alone, for the commands that run a model on the CPU only (eval, compare): registers it
+// on `cmd`, and with `bf16` set makes the process's products bf16, or throws ConfigError saying
+// why this build or machine cannot.
+void add_bf16_option(CLI::App& cmd, bool& bf16);
+void use_bf16_products(bool bf16);
+
 }  // namespace fignet::cli

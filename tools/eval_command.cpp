@@ -5,11 +5,13 @@
 
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <optional>
 
 #include "commands.h"
+#include "device_option.h"
 #include "fignet/error.h"
 #include "fignet/io/model_file.h"
 #include "fignet/io/trajectory_file.h"
@@ -30,7 +32,7 @@ struct EvalArgs {
   std::vector<fs::path> models, data;
   fs::path json;
   int frames = -1, max_trajectories = -1, threads = 1, turns = 1;
-  bool free_flight = false, mirror = false;
+  bool free_flight = false, mirror = false, bf16 = false;
   bool baseline = true, penetration = true, regimes = true;
 };
 
@@ -161,18 +163,25 @@ void print_regimes(const std::vector<Row>& rows) {
 }
 
 void print_table(const std::vector<Row>& rows) {
-  fmt::print("\n{:<34} {:>21} {:>21} {:>7} {:>15} {:>10} {:>8}\n", "", "translation (m)",
-             "rotation (deg)", "", "penetration", "face-face", "");
-  fmt::print("{:<34} {:>10} {:>10} {:>10} {:>10} {:>7} {:>7} {:>7} {:>10} {:>8}\n", "run", "mean",
-             "last", "mean", "last", "travel", "depth", "count", "edges", "ms/step");
+  // The run column fits the longest name ("M.h5, free flight, bf16 products (FIGNet)").
+  std::vector<std::string> names;
+  size_t width = 34;
   for (const Row& row : rows) {
-    const Evaluation& e = row.result;
+    names.push_back(fmt::format("{} ({})", row.name, row.kind));
+    width = std::max(width, names.back().size());
+  }
+  fmt::print("\n{:<{}} {:>21} {:>21} {:>7} {:>15} {:>10} {:>8}\n", "", width, "translation (m)",
+             "rotation (deg)", "", "penetration", "face-face", "");
+  fmt::print("{:<{}} {:>10} {:>10} {:>10} {:>10} {:>7} {:>7} {:>7} {:>10} {:>8}\n", "run", width,
+             "mean", "last", "mean", "last", "travel", "depth", "count", "edges", "ms/step");
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const Evaluation& e = rows[r].result;
     fmt::print(
-        "{:<34} {:>10.4f} {:>10.4f} {:>10.2f} {:>10.2f} {:>7.3f} {:>7.2f} {:>7.2f} {:>10.1f} "
+        "{:<{}} {:>10.4f} {:>10.4f} {:>10.2f} {:>10.2f} {:>7.3f} {:>7.2f} {:>7.2f} {:>10.1f} "
         "{:>8.3f}\n",
-        fmt::format("{} ({})", row.name, row.kind), e.mean_translation, e.final_translation,
-        e.mean_rotation, e.final_rotation, e.travel_ratio, e.penetration_depth_ratio,
-        e.penetration_count_ratio, e.face_edges_per_step, e.milliseconds_per_step);
+        names[r], width, e.mean_translation, e.final_translation, e.mean_rotation, e.final_rotation,
+        e.travel_ratio, e.penetration_depth_ratio, e.penetration_count_ratio, e.face_edges_per_step,
+        e.milliseconds_per_step);
   }
   fmt::print(
       "\nmean: over each rollout's predicted frames, then over trajectories; last: the final "
@@ -240,6 +249,7 @@ nlohmann::json to_json(const Row& row) {
 }
 
 void run_eval(const EvalArgs& args) {
+  use_bf16_products(args.bf16);
   const std::vector<Trajectory> test = read_test_split(args);
   const bool root = process_group().is_root();
   std::vector<Row> rows;
@@ -257,7 +267,8 @@ void run_eval(const EvalArgs& args) {
                                      .turns = args.turns,
                                      .mirror = args.mirror,
                                      .free_flight = args.free_flight});
-    const std::string name = file.filename().string() + (args.free_flight ? ", free flight" : "");
+    const std::string name = file.filename().string() + (args.free_flight ? ", free flight" : "") +
+                             (args.bf16 ? ", bf16 products" : "");
     rows.push_back(evaluate(name, kind_of(config), predictor, test, args));
     if (args.regimes) {
       // Every row is split by the first model's graph, in its units.
@@ -347,6 +358,7 @@ void add_eval_command(CLI::App& app) {
                   "vertical (PredictionOptions::turns; turns times the cost)")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
+  add_bf16_option(*cmd, args->bf16);
   cmd->add_flag("--mirror", args->mirror,
                 "Average with the scene seen in a mirror too, at each turn (PredictionOptions::"
                 "mirror; twice --turns' cost)");
