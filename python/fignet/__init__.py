@@ -21,6 +21,7 @@ from ._fignet import (  # noqa: F401
     Model,
     Scene,
     Trajectory,
+    bf16_products,
     compare_paired,
     evaluate,
     generate,
@@ -29,6 +30,7 @@ from ._fignet import (  # noqa: F401
     read_trajectories,
     rollout,
     rollout_errors,
+    set_bf16_products,
     write_trajectories,
 )
 from ._fignet import __version__  # noqa: F401
@@ -40,6 +42,7 @@ __all__ = [
     "Model",
     "Scene",
     "Trajectory",
+    "bf16_products",
     "compare_paired",
     "evaluate",
     "generate",
@@ -48,5 +51,6 @@ __all__ = [
     "read_trajectories",
     "rollout",
     "rollout_errors",
+    "set_bf16_products",
     "write_trajectories",
 ]

@@ -8,6 +8,7 @@
 #include "bindings.h"
 #include "fignet/error.h"
 #include "fignet/io/model_file.h"
+#include "fignet/nn/gemm.h"
 #include "fignet/rollout/rollout.h"
 #include "fignet/train/training_config.h"
 
@@ -164,6 +165,21 @@ x[t+1] − 2x[t] + x[t−1] in metres, and the next "positions" (objects, 3) and
 `given_frames` frames (default history + 1) are the truth, every later frame up to `frames`
 (default all) is predicted from the model's own previous predictions. Kinematic objects follow
 their recorded poses. Returns a Trajectory with the predicted poses.)");
+  m.def(
+      "set_bf16_products",
+      [](bool on) {
+        const GemmPrecision precision = on ? GemmPrecision::kBf16 : GemmPrecision::kF32;
+        const std::string why_not = gemm_precision_unavailable(precision);
+        if (!why_not.empty()) throw ConfigError("set_bf16_products: " + why_not);
+        set_gemm_precision(precision);
+      },
+      py::arg("on") = true,
+      R"(Runs every model's matrix products in bfloat16 from now on (False: back to float32), for the
+whole process: rollouts, evaluations and scenes alike, as `fignet eval --bf16` does. Needs bf16
+instructions (AVX512-BF16 or AMX); raises ConfigError saying why where they are missing.)");
+  m.def(
+      "bf16_products", [] { return gemm_precision() == GemmPrecision::kBf16; },
+      "Whether the matrix products run in bfloat16 (set_bf16_products).");
 }
 
 }  // namespace fignet::python

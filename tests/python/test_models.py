@@ -91,3 +91,25 @@ def test_pose_errors_on_numpy_equal_rollout_errors(model):
     c = fignet.pose_errors(shifted, truth.quaternions, truth.positions, truth.quaternions)
     np.testing.assert_allclose(c["translation"][3:], 1.0, rtol=1e-12)
     assert c["mean_rotation"] < 1e-9
+
+
+def test_bf16_products_move_an_evaluation_a_little_or_are_refused_with_the_reason(model):
+    (truth,) = fignet.generate("movi-a", count=1, seed=21, frames=12)
+    plain = fignet.evaluate(model, [truth])
+    try:
+        fignet.set_bf16_products(True)
+    except fignet.ConfigError as refused:
+        assert "set_bf16_products" in str(refused)
+        assert not fignet.bf16_products()
+        return
+    try:
+        assert fignet.bf16_products()
+        rounded = fignet.evaluate(model, [truth])
+    finally:
+        fignet.set_bf16_products(False)
+    assert not fignet.bf16_products()
+    # Operands rounded to 8 significant bits: another rollout, of about the same error.
+    assert rounded["mean_translation_m"] != plain["mean_translation_m"]
+    assert abs(rounded["mean_translation_m"] - plain["mean_translation_m"]) < 0.5 * max(
+        plain["mean_translation_m"], 0.01)
+    assert fignet.evaluate(model, [truth])["mean_translation_m"] == plain["mean_translation_m"]
