@@ -941,6 +941,23 @@ TEST(ModelPredictor, PredictionsAveragedWithTheMirrorReflectWithTheScene) {
   EXPECT_GT(reflected_difference(two), 1e-2);
 }
 
+TEST(ModelPredictor, MirrorsFollowMeshesThatComeAndGo) {
+  // One predictor over scenes whose meshes are made and freed in turn (new meshes often at a
+  // freed one's address; the mirrors of meshes no longer seen are let go once they pile up):
+  // each prediction is a fresh predictor's.
+  auto model = random_model(testing::make_random_scene(13, 3, 0.6).scene);
+  ModelPredictor kept(model, {.mirror = true});
+  for (unsigned seed = 0; seed < 30; ++seed) {
+    SCOPED_TRACE(::testing::Message() << "scene " << seed);
+    const auto fixture = testing::make_random_scene(100 + seed, 3, 0.6);
+    Points expected, predicted;
+    ModelPredictor(model, {.mirror = true}).predict(fixture.scene, expected);
+    kept.predict(fixture.scene, predicted);
+    ASSERT_EQ(predicted.rows(), expected.rows());
+    EXPECT_LT((predicted - expected).cwiseAbs().maxCoeff(), 1e-6 * expected.cwiseAbs().maxCoeff());
+  }
+}
+
 TEST(ModelPredictor, TurnedCopiesOnSeveralThreadsPredictAsOnOne) {
   // With threads other than 1 the turned (and mirrored) copies run one per thread, each on its own
   // builder, graph and workspace: the same predictions as one after another (products on one thread

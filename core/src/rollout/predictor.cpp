@@ -134,12 +134,17 @@ void ModelPredictor::update_mirrors(const Scene& scene) {
     auto entry = std::find_if(mirrors_.begin(), mirrors_.end(),
                               [&](const auto& e) { return e.first == &mesh; });
     // A mesh freed and another made at its address is told apart by its vertices and faces.
-    const bool current = entry != mirrors_.end() &&
-                         entry->second->num_faces() == mesh.num_faces() &&
-                         entry->second->vertices().rows() == mesh.vertices().rows() &&
-                         entry->second->vertices().col(1) == -mesh.vertices().col(1) &&
-                         entry->second->vertices().col(0) == mesh.vertices().col(0) &&
-                         entry->second->vertices().col(2) == mesh.vertices().col(2);
+    auto mirrors = [&](const TriangleMesh& mirror) {
+      return mirror.vertices().rows() == mesh.vertices().rows() &&
+             mirror.faces().rows() == mesh.faces().rows() &&
+             mirror.vertices().col(0) == mesh.vertices().col(0) &&
+             mirror.vertices().col(1) == -mesh.vertices().col(1) &&
+             mirror.vertices().col(2) == mesh.vertices().col(2) &&
+             mirror.faces().col(0) == mesh.faces().col(0) &&
+             mirror.faces().col(1) == mesh.faces().col(2) &&
+             mirror.faces().col(2) == mesh.faces().col(1);
+    };
+    const bool current = entry != mirrors_.end() && mirrors(*entry->second);
     if (current) continue;
     auto mirror = std::make_unique<const TriangleMesh>(mirrored_mesh(mesh));
     if (entry != mirrors_.end()) {
