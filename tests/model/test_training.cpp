@@ -971,7 +971,7 @@ TEST(ModelPredictor, TurnedCopiesOnSeveralThreadsPredictAsOnOne) {
     for (int b = a + 1; b < n; ++b) all_pairs.push_back({a, b});
   }
   for (const auto& [free_flight, mirror] :
-       {std::pair(false, false), {true, false}, {false, true}}) {
+       {std::pair(false, false), {true, false}, {false, true}, {true, true}}) {
     for (const bool with_candidates : {false, true}) {
       SCOPED_TRACE(::testing::Message() << "free_flight " << free_flight << ", mirror " << mirror
                                         << ", candidates " << with_candidates);
