@@ -121,14 +121,11 @@ void ModelPredictor::make_copy(int k, const Scene& scene, Scene& copy) const {
   copy = scene;  // copy-assigned: a steady-state step reuses the last one's buffers
   map_about_vertical(copy_map(k), copy);
   if (k < options_.turns) return;
-  for (SceneObject& object : copy.objects) {
-    const auto mirror = std::find_if(mirrors_.begin(), mirrors_.end(),
-                                     [&](const auto& entry) { return entry.first == object.mesh; });
-    object.mesh = mirror->second.get();  // update_mirrors() has made one for every mesh
-  }
+  for (size_t o = 0; o < copy.objects.size(); ++o) copy.objects[o].mesh = object_mirrors_[o];
 }
 
 void ModelPredictor::update_mirrors(const Scene& scene) {
+  object_mirrors_.clear();
   for (const SceneObject& object : scene.objects) {
     const TriangleMesh& mesh = *object.mesh;
     auto entry = std::find_if(mirrors_.begin(), mirrors_.end(),
@@ -144,17 +141,16 @@ void ModelPredictor::update_mirrors(const Scene& scene) {
              mirror.faces().col(1) == mesh.faces().col(2) &&
              mirror.faces().col(2) == mesh.faces().col(1);
     };
-    const bool current = entry != mirrors_.end() && mirrors(*entry->second);
-    if (current) continue;
-    auto mirror = std::make_unique<const TriangleMesh>(mirrored_mesh(mesh));
-    if (entry != mirrors_.end()) {
-      entry->second = std::move(mirror);
-    } else {
-      mirrors_.emplace_back(&mesh, std::move(mirror));
+    if (entry == mirrors_.end()) {
+      entry = mirrors_.emplace(mirrors_.end(), &mesh, nullptr);
     }
+    if (!entry->second || !mirrors(*entry->second)) {
+      entry->second = std::make_unique<const TriangleMesh>(mirrored_mesh(mesh));
+    }
+    object_mirrors_.push_back(entry->second.get());
   }
   // Bodies come and go (a world's spawner): the mirrors of meshes no longer seen are let go once
-  // they outnumber the scene's own.
+  // they outnumber the scene's own (the scene's own, in object_mirrors_, stay where they are).
   if (mirrors_.size() > 2 * scene.objects.size() + 16) {
     std::erase_if(mirrors_, [&](const auto& entry) {
       return std::none_of(scene.objects.begin(), scene.objects.end(),

@@ -157,9 +157,10 @@ class ModelPredictor : public AccelerationPredictor {
   // vertical, after a reflection y ↦ −y for the mirrored copies (k >= turns).
   Eigen::Matrix3d copy_map(int k) const;
   // Makes `copy` scene's copy k: the scene mapped by copy_map(k), with mirrored meshes for k >=
-  // turns (from mirrors_, which update_mirrors() has filled for the scene's meshes).
+  // turns (object_mirrors_, which update_mirrors() has filled for the scene).
   void make_copy(int k, const Scene& scene, Scene& copy) const;
-  // Makes mirrors_ hold the mirror of each of the scene's meshes (kept from step to step).
+  // Makes mirrors_ hold the mirror of each of the scene's meshes (kept from step to step), and
+  // object_mirrors_ point to each object's.
   void update_mirrors(const Scene& scene);
   // Adds copy k's accelerations, mapped back, to turned_sum_ (copy 1 starts it).
   void add_turned_back(int k, const Points& turned);
@@ -193,7 +194,8 @@ class ModelPredictor : public AccelerationPredictor {
   std::vector<std::unique_ptr<TurnedCopy>> copies_;  // copies() − 1, when turn_threads() > 1
   // Each mesh of the scenes seen so far with its mirror, for the mirrored copies.
   std::vector<std::pair<const TriangleMesh*, std::unique_ptr<const TriangleMesh>>> mirrors_;
-  std::vector<std::exception_ptr> copy_errors_;  // what each copy's thread threw
+  std::vector<const TriangleMesh*> object_mirrors_;  // the mirror of each object's mesh, in order
+  std::vector<std::exception_ptr> copy_errors_;      // what each copy's thread threw
   FreeFlightSplit free_flight_;
   Scene kept_;                   // the scene's objects with a collision edge (omit_free_flight)
   SceneContacts kept_contacts_;  // and their collision pairs, as the split's search found them
