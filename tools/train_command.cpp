@@ -22,6 +22,7 @@
 #include "fignet/io/trajectory_file.h"
 #include "fignet/nn/gemm.h"
 #include "fignet/rollout/evaluation.h"
+#include "fignet/train/deepen.h"
 #include "fignet/train/training_config.h"
 #include "process_group.h"
 #include "progress.h"
@@ -41,6 +42,7 @@ struct TrainArgs {
   std::vector<std::string> settings;
   std::int64_t steps = -1;
   bool resume = false;
+  int deepen = 0;  // message-passing steps added to the resumed run's model
   double checkpoint_minutes = 10.0;
   std::int64_t log_every = 100, valid_every = 2000;
   int valid_trajectories = 10, threads = 0;
@@ -208,6 +210,18 @@ void run_train(const TrainArgs& args) {
   int resumed_batch_size = 0;  // the checkpoint's, before any --set
   if (args.resume) {
     Checkpoint checkpoint = load_checkpoint(checkpoint_path);
+    if (args.deepen > 0) {
+      const int trained = checkpoint.model->config().message_passing_steps;
+      DeepenedRun deeper = deepen(*checkpoint.model, checkpoint.state, args.deepen);
+      checkpoint.model = std::move(deeper.model);
+      checkpoint.state = std::move(deeper.state);
+      if (root) {
+        fmt::print(
+            "deepened: message_passing_steps {} -> {} (the new steps start as the identity: "
+            "the same predictions)\n",
+            trained, checkpoint.model->config().message_passing_steps);
+      }
+    }
     const std::int64_t steps = config.steps;
     config.model = checkpoint.model->config();
     if (config.model.mesh_vertices == 0) config.model.mesh_vertices = most_mesh_vertices(data);
@@ -428,6 +442,13 @@ void add_train_command(CLI::App& app) {
                 "change it")
       ->excludes(preset)
       ->excludes(config);
+  cmd->add_option("--deepen", args->deepen,
+                  "With --resume: add this many message-passing steps to the run's model, spread "
+                  "among its trained ones, each starting as the identity (so the deeper network "
+                  "first predicts what the trained one did); the run continues deeper in the same "
+                  "files, so copy them first to keep the original")
+      ->check(CLI::Range(1, 64))
+      ->needs("--resume");
   cmd->add_option("--checkpoint-minutes", args->checkpoint_minutes, "Minutes between checkpoints")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
