@@ -42,7 +42,8 @@ struct TrainArgs {
   std::vector<std::string> settings;
   std::int64_t steps = -1;
   bool resume = false;
-  int deepen = 0;  // message-passing steps added to the resumed run's model
+  int deepen = 0;             // message-passing steps added to the resumed run's model
+  float deepen_scale = 0.0f;  // their LayerNorm scales at the start (0: the identity)
   double checkpoint_minutes = 10.0;
   std::int64_t log_every = 100, valid_every = 2000;
   int valid_trajectories = 10, threads = 0;
@@ -212,14 +213,17 @@ void run_train(const TrainArgs& args) {
     Checkpoint checkpoint = load_checkpoint(checkpoint_path);
     if (args.deepen > 0) {
       const int trained = checkpoint.model->config().message_passing_steps;
-      DeepenedRun deeper = deepen(*checkpoint.model, checkpoint.state, args.deepen);
+      DeepenedRun deeper =
+          deepen(*checkpoint.model, checkpoint.state, args.deepen, args.deepen_scale);
       checkpoint.model = std::move(deeper.model);
       checkpoint.state = std::move(deeper.state);
       if (root) {
         fmt::print(
-            "deepened: message_passing_steps {} -> {} (the new steps start as the identity: "
-            "the same predictions)\n",
-            trained, checkpoint.model->config().message_passing_steps);
+            "deepened: message_passing_steps {} -> {} ({})\n", trained,
+            checkpoint.model->config().message_passing_steps,
+            args.deepen_scale == 0.0f
+                ? "the new steps start as the identity: the same predictions"
+                : fmt::format("the new steps' LayerNorm scales start at {}", args.deepen_scale));
       }
     }
     const std::int64_t steps = config.steps;
@@ -449,6 +453,12 @@ void add_train_command(CLI::App& app) {
                   "files, so copy them first to keep the original")
       ->check(CLI::Range(1, 64))
       ->needs("--resume");
+  cmd->add_option("--deepen-scale", args->deepen_scale,
+                  "With --deepen: the new steps' LayerNorm scales at the start (0: the identity; "
+                  "a small positive one, e.g. 0.1, lets their weights learn from the first step)")
+      ->check(CLI::Range(0.0f, 1.0f))
+      ->needs("--deepen")
+      ->capture_default_str();
   cmd->add_option("--checkpoint-minutes", args->checkpoint_minutes, "Minutes between checkpoints")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "../error_text.h"
 #include "fignet/data/trajectory.h"
 #include "fignet/error.h"
@@ -115,6 +117,30 @@ TEST(Deepen, TheDeeperNetworkPredictsWhatTheTrainedOneDidAndTrainsOn) {
   EXPECT_EQ(resumed.steps_done(), 5);
   const size_t scale = offset_of(model, "processor/1/mesh_node/layer_norm/scale");
   EXPECT_NE(resumed.parameters()[scale], 0.0f);
+}
+
+// A small starting scale: the new steps add that fraction of a normalised update, so the
+// predictions move a little, and the scales start there.
+TEST(Deepen, NewStepsMayStartWithASmallScale) {
+  const auto data = cubes_in_contact();
+  const auto trained = std::make_shared<const Model>(tiny_model(2));
+  const DeepenedRun identity = deepen(*trained, TrainerState{}, 2);
+  const DeepenedRun scaled = deepen(*trained, TrainerState{}, 2, 0.25f);
+  EXPECT_EQ(scaled.model
+                ->parameters()[offset_of(*scaled.model, "processor/1/mesh_node/layer_norm/scale")],
+            0.25f);
+  const Points before = predict(trained, data[0]);
+  EXPECT_EQ(predict(identity.model, data[0]), before);
+  const Points after = predict(scaled.model, data[0]);
+  EXPECT_GT((after - before).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_TRUE(scaled.state.first_moment.empty());  // a model without a run: no moments to carry
+  for (float bad : {-0.1f, 1.5f, std::numeric_limits<float>::quiet_NaN()}) {
+    EXPECT_NE(testing::error_of<ConfigError>([&] {
+                deepen(*trained, TrainerState{}, 2, bad);
+              }).find("must be in 0..1"),
+              std::string::npos)
+        << bad;
+  }
 }
 
 TEST(Deepen, AStateOfAnotherModelIsRefused) {

@@ -41,7 +41,12 @@ std::vector<int> deepened_step_sources(int trained, int added) {
   return sources;
 }
 
-DeepenedRun deepen(const Model& model, const TrainerState& state, int added_steps) {
+DeepenedRun deepen(const Model& model, const TrainerState& state, int added_steps,
+                   float new_step_scale) {
+  if (!(new_step_scale >= 0.0f && new_step_scale <= 1.0f)) {
+    throw ConfigError(
+        fmt::format("deepen: new steps' LayerNorm scale {} (must be in 0..1)", new_step_scale));
+  }
   const ModelConfig& trained_config = model.config();
   const std::vector<int> sources =
       deepened_step_sources(trained_config.message_passing_steps, added_steps);
@@ -77,8 +82,9 @@ DeepenedRun deepen(const Model& model, const TrainerState& state, int added_step
     const int source = step < 0 ? -1 : sources[step];
     float* const begin = params.data() + t.offset;
     if (step >= 0 && source < 0) {
-      // A new step: the identity through its residual, LayerNorm's output held at zero.
-      if (rest.ends_with("/layer_norm/scale")) std::fill(begin, begin + t.size(), 0.0f);
+      // A new step: LayerNorm's output zero (the identity through the residual) or a fraction of
+      // a normalised update.
+      if (rest.ends_with("/layer_norm/scale")) std::fill(begin, begin + t.size(), new_step_scale);
       if (!run.state.averaged_parameters.empty()) {
         std::copy(begin, begin + t.size(), run.state.averaged_parameters.begin() + t.offset);
       }
