@@ -449,8 +449,9 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--deepen", args->deepen,
                   "With --resume: add this many message-passing steps to the run's model, spread "
                   "among its trained ones, each starting as the identity (so the deeper network "
-                  "first predicts what the trained one did); the run continues deeper in the same "
-                  "files, so copy them first to keep the original")
+                  "first predicts what the trained one did) unless --deepen-scale says otherwise; "
+                  "the run continues deeper in the same files, so copy them first to keep the "
+                  "original")
       ->check(CLI::Range(1, 64))
       ->needs("--resume");
   cmd->add_option("--deepen-scale", args->deepen_scale,
