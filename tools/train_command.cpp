@@ -401,8 +401,12 @@ void run_train(const TrainArgs& args) {
     fmt::print("stopped at step {}; checkpoint {} (continue with --resume)\n", trainer.steps_done(),
                checkpoint_path.string());
   } else {
-    fmt::print("trained {} steps; model {}, checkpoint {}, log {}\n", trainer.steps_done(),
-               args.out.string(), checkpoint_path.string(), log_path.string());
+    // A resumed run says what this process added as well as where the run stands.
+    const std::int64_t added = trainer.steps_done() - first_step;
+    std::string steps = fmt::format("trained {} step{}", added, added == 1 ? "" : "s");
+    if (first_step > 0) steps += fmt::format(" (step {} to {})", first_step, trainer.steps_done());
+    fmt::print("{}; model {}, checkpoint {}, log {}\n", steps, args.out.string(),
+               checkpoint_path.string(), log_path.string());
   }
 }
 

@@ -39,7 +39,7 @@ step=$("$fignet" train --data "$work/set.h5" --threads 1 --resume --steps 0 \
     | sed -n 's/^resuming .* at step \([0-9]*\)$/\1/p')
 [ -n "$step" ] || { echo "the checkpoint left by the killed run does not load"; exit 1; }
 "$fignet" train --data "$work/set.h5" --threads 1 --resume --steps $((step + 2)) \
-    --out "$work/model.h5" 2>/dev/null | grep "trained $((step + 2)) steps"
+    --out "$work/model.h5" 2>/dev/null | grep -E "trained 2 steps( \(step $step to $((step + 2))\))?;"
 
 # train: SIGTERM mid-step, three times at different moments of the steps.
 for delay in 0.3 0.7 1.1; do
