@@ -22,7 +22,7 @@
 #include "fignet/io/trajectory_file.h"
 #include "fignet/nn/gemm.h"
 #include "fignet/rollout/evaluation.h"
-#include "fignet/train/deepen.h"
+#include "fignet/train/grow.h"
 #include "fignet/train/training_config.h"
 #include "process_group.h"
 #include "progress.h"
@@ -42,8 +42,10 @@ struct TrainArgs {
   std::vector<std::string> settings;
   std::int64_t steps = -1;
   bool resume = false;
-  int deepen = 0;             // message-passing steps added to the resumed run's model
-  float deepen_scale = 0.0f;  // their LayerNorm scales at the start (0: the identity)
+  int deepen = 0;               // message-passing steps added to the resumed run's model
+  float deepen_scale = 0.0f;    // their LayerNorm scales at the start (0: the identity)
+  int widen_hidden = 0;         // the resumed run's MLPs' hidden width grown to this (0: kept)
+  int widen_object_hidden = 0;  // ... and its object-node MLPs'
   double checkpoint_minutes = 10.0;
   std::int64_t log_every = 100, valid_every = 2000;
   int valid_trajectories = 10, threads = 0;
@@ -213,8 +215,7 @@ void run_train(const TrainArgs& args) {
     Checkpoint checkpoint = load_checkpoint(checkpoint_path);
     if (args.deepen > 0) {
       const int trained = checkpoint.model->config().message_passing_steps;
-      DeepenedRun deeper =
-          deepen(*checkpoint.model, checkpoint.state, args.deepen, args.deepen_scale);
+      GrownRun deeper = deepen(*checkpoint.model, checkpoint.state, args.deepen, args.deepen_scale);
       checkpoint.model = std::move(deeper.model);
       checkpoint.state = std::move(deeper.state);
       if (root) {
@@ -224,6 +225,21 @@ void run_train(const TrainArgs& args) {
             args.deepen_scale == 0.0f
                 ? "the new steps start as the identity: the same predictions"
                 : fmt::format("the new steps' LayerNorm scales start at {}", args.deepen_scale));
+      }
+    }
+    if (args.widen_hidden > 0 || args.widen_object_hidden > 0) {
+      const ModelConfig& trained = checkpoint.model->config();
+      const int hidden = trained.mlp_hidden(), object_hidden = trained.object_mlp_hidden();
+      GrownRun wider =
+          widen(*checkpoint.model, checkpoint.state, args.widen_hidden, args.widen_object_hidden);
+      checkpoint.model = std::move(wider.model);
+      checkpoint.state = std::move(wider.state);
+      if (root) {
+        fmt::print(
+            "widened: MLPs' hidden width {} -> {}, object-node MLPs' {} -> {} (new units' "
+            "outgoing weights start at zero: the same predictions)\n",
+            hidden, checkpoint.model->config().mlp_hidden(), object_hidden,
+            checkpoint.model->config().object_mlp_hidden());
       }
     }
     const std::int64_t steps = config.steps;
@@ -464,6 +480,18 @@ void add_train_command(CLI::App& app) {
       ->check(CLI::Range(0.0f, 1.0f))
       ->needs("--deepen")
       ->capture_default_str();
+  cmd->add_option("--widen-hidden", args->widen_hidden,
+                  "With --resume: widen the hidden layers of the run's MLPs to this many units "
+                  "(hidden_size; new units start with zero outgoing weights, so the wider network "
+                  "first predicts what the trained one did); the run continues wider in the same "
+                  "files, so copy them first to keep the original")
+      ->check(CLI::Range(1, 4096))
+      ->needs("--resume");
+  cmd->add_option("--widen-object-hidden", args->widen_object_hidden,
+                  "With --resume: the same for the object-node MLPs alone (object_hidden_size: "
+                  "one row per body, so nearly free)")
+      ->check(CLI::Range(1, 4096))
+      ->needs("--resume");
   cmd->add_option("--checkpoint-minutes", args->checkpoint_minutes, "Minutes between checkpoints")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();

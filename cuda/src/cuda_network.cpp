@@ -419,7 +419,7 @@ ConstMatrixView CudaBackend::forward(const float* params, const Normalizers& nor
     for (int t = 0; t < kinds; ++t) {
       const DeviceEdges& edges = edges_[t];
       const Mlp& mlp = step.edges[t];
-      const DeviceMatrix z = first_.view(edges.count, l);
+      const DeviceMatrix z = first_.view(edges.count, mlp.hidden());
       gemm(blas_, cur.edges[t].get(), false, first_weight(mlp, p, 0), false, z, 0.0f, stream_);
       add_gathered_product(node_latents(cur, network_.sender_set(t)).get(), first_weight(mlp, p, 1),
                            {edges.senders.data(), edges.count, 1, 0}, z);
@@ -431,7 +431,7 @@ ConstMatrixView CudaBackend::forward(const float* params, const Normalizers& nor
     }
     if (face_edges) {
       const Mlp& mlp = step.face;
-      const DeviceMatrix z = first_.zeros(faces_, l, stream_);
+      const DeviceMatrix z = first_.zeros(faces_, mlp.hidden(), stream_);
       const DeviceMatrix q = cur.face.get();
       for (int j = 0; j < 3; ++j) {
         add_product(q.columns(j * l, l), first_weight(mlp, p, 3 * j), z);
@@ -446,7 +446,7 @@ ConstMatrixView CudaBackend::forward(const float* params, const Normalizers& nor
     }
     // Node updates: [v, Σ incoming latents per edge type] with residuals.
     auto update_nodes = [&](NodeSet set, const Mlp& mlp, MlpCache& cache, int count) {
-      const DeviceMatrix z = first_.view(count, l);
+      const DeviceMatrix z = first_.view(count, mlp.hidden());
       gemm(blas_, node_latents(cur, set).get(), false, first_weight(mlp, p, 0), false, z, 0.0f,
            stream_);
       int block = 1;

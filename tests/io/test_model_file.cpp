@@ -21,6 +21,8 @@ class ModelFile : public testing::TempFolderTest {
     ModelConfig config = ModelConfig::preset_named("small");
     config.latent_size = 16;
     config.message_passing_steps = 2;
+    config.hidden_size = 24;
+    config.object_hidden_size = 40;
     config.seed = 42;
     config.noise_correction = 0.25;
     config.random_yaw = true;
@@ -66,6 +68,8 @@ TEST_F(ModelFile, SaveThenLoadIsBitExact) {
   const Model loaded = load_model(path_);
   EXPECT_EQ(loaded.parameters(), model_->parameters());
   EXPECT_EQ(loaded.config().latent_size, 16);
+  EXPECT_EQ(loaded.config().hidden_size, 24);
+  EXPECT_EQ(loaded.config().object_hidden_size, 40);
   EXPECT_EQ(loaded.config().seed, 42u);
   EXPECT_EQ(loaded.config().graph.collision_radius, model_->config().graph.collision_radius);
   EXPECT_EQ(loaded.config().time_step, model_->config().time_step);

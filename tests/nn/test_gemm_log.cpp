@@ -75,14 +75,16 @@ TEST(GemmLog, OneAtATime) {
   EXPECT_EQ(again.shapes().size(), 1u);
 }
 
-// A small-preset network on `count` MOVi-A-like scenes of 3, 4, ... objects, random parameters.
+// A small-preset network (or `config`'s) on `count` MOVi-A-like scenes of 3, 4, ... objects,
+// random parameters.
 struct Scenes {
   Graph graph;
-  Network network{ModelConfig::preset_named("small")};
+  Network network;
   std::vector<float> params;
   Normalizers normalizers;
 
-  explicit Scenes(int count) {
+  explicit Scenes(int count, const ModelConfig& config = ModelConfig::preset_named("small"))
+      : network(config) {
     const std::vector<RestingLattice> lattices =
         testing::movi_a_lattices(count, [](int s) { return 3 + s; });
     GraphBuilder(network.config().graph).build(testing::scenes_of(lattices), graph);
@@ -99,6 +101,19 @@ TEST(GemmLog, ForwardFlopsAreTheNetworksCount) {
   GemmLog log;
   s.network.forward(s.params.data(), s.normalizers, s.graph, workspace, false);
   EXPECT_NEAR(log.flops(), s.network.forward_flops(s.graph), 1e-9 * log.flops());
+}
+
+// ... also with hidden layers wider than the latents, the object-node MLPs' wider still.
+TEST(GemmLog, ForwardFlopsCountWiderHiddenLayers) {
+  ModelConfig config = ModelConfig::preset_named("small");
+  config.hidden_size = 96;
+  config.object_hidden_size = 256;
+  const Scenes s(2, config);
+  NetworkWorkspace workspace;
+  GemmLog log;
+  s.network.forward(s.params.data(), s.normalizers, s.graph, workspace, false);
+  EXPECT_NEAR(log.flops(), s.network.forward_flops(s.graph), 1e-9 * log.flops());
+  EXPECT_GT(s.network.forward_flops(s.graph), Scenes(2).network.forward_flops(s.graph) * 1.5);
 }
 
 // The products of a batch's forward and backward, as a sorted list (threads start them in any

@@ -12,9 +12,12 @@
 namespace fignet {
 namespace {
 
-ModelConfig tiny_config(CollisionEdges collisions, bool object_nodes) {
+ModelConfig tiny_config(CollisionEdges collisions, bool object_nodes, int hidden = 0,
+                        int object_hidden = 0) {
   ModelConfig config = ModelConfig::preset_named("small");
   config.latent_size = 8;
+  config.hidden_size = hidden;
+  config.object_hidden_size = object_hidden;
   config.message_passing_steps = 2;
   config.graph.collisions = collisions;
   config.graph.object_nodes = object_nodes;
@@ -26,12 +29,14 @@ ModelConfig tiny_config(CollisionEdges collisions, bool object_nodes) {
 struct Variant {
   CollisionEdges collisions;
   bool object_nodes;
+  int hidden = 0, object_hidden = 0;  // 0: the latent width
 };
 
 class NetworkGradient : public ::testing::TestWithParam<Variant> {};
 
 TEST_P(NetworkGradient, MatchesFiniteDifferences) {
-  const ModelConfig config = tiny_config(GetParam().collisions, GetParam().object_nodes);
+  const ModelConfig config = tiny_config(GetParam().collisions, GetParam().object_nodes,
+                                         GetParam().hidden, GetParam().object_hidden);
   const Network network(config);
   std::vector<float> params;
   network.layout().initialize(params, 7);
@@ -93,7 +98,8 @@ TEST_P(NetworkGradient, MatchesFiniteDifferences) {
 INSTANTIATE_TEST_SUITE_P(Variants, NetworkGradient,
                          ::testing::Values(Variant{CollisionEdges::kFaceFace, true},
                                            Variant{CollisionEdges::kFaceFace, false},
-                                           Variant{CollisionEdges::kNodeNode, true}));
+                                           Variant{CollisionEdges::kNodeNode, true},
+                                           Variant{CollisionEdges::kFaceFace, true, 12, 20}));
 
 TEST(Network, ParameterNamesAreStableAndComplete) {
   const Network network(ModelConfig::preset_named("paper"));

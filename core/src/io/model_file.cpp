@@ -35,6 +35,8 @@ void write_config(H5::Group group, const ModelConfig& c) {
   write_attribute(group, "preset", c.preset);
   write_attribute(group, "latent_size", static_cast<long long>(c.latent_size));
   write_attribute(group, "message_passing_steps", static_cast<long long>(c.message_passing_steps));
+  write_attribute(group, "hidden_size", static_cast<long long>(c.hidden_size));
+  write_attribute(group, "object_hidden_size", static_cast<long long>(c.object_hidden_size));
   write_attribute(group, "noise_std", c.noise_std);
   write_attribute(group, "normalizer_max_accumulations",
                   static_cast<long long>(c.normalizer_max_accumulations));
@@ -81,6 +83,9 @@ ModelConfig read_config(const H5::Group& group) {
   c.preset = read_string(group, "preset");
   c.latent_size = static_cast<int>(read_integer(group, "latent_size"));
   c.message_passing_steps = static_cast<int>(read_integer(group, "message_passing_steps"));
+  c.hidden_size = static_cast<int>(read_integer_or(group, "hidden_size", c.hidden_size));
+  c.object_hidden_size =
+      static_cast<int>(read_integer_or(group, "object_hidden_size", c.object_hidden_size));
   c.noise_std = read_double(group, "noise_std");
   c.normalizer_max_accumulations = read_integer(group, "normalizer_max_accumulations");
   c.time_step = read_double(group, "time_step");

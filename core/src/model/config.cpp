@@ -52,6 +52,10 @@ void ModelConfig::validate() const {
     throw ConfigError(fmt::format("model config: {} = {} ({})", field, value, rule));
   };
   if (latent_size < 1 || latent_size > 4096) fail("latent_size", latent_size, "must be in 1..4096");
+  if (hidden_size < 0 || hidden_size > 4096) fail("hidden_size", hidden_size, "must be in 0..4096");
+  if (object_hidden_size < 0 || object_hidden_size > 4096) {
+    fail("object_hidden_size", object_hidden_size, "must be in 0..4096");
+  }
   if (message_passing_steps < 0 || message_passing_steps > 64) {
     fail("message_passing_steps", message_passing_steps, "must be in 0..64");
   }

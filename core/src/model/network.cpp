@@ -72,19 +72,19 @@ Network::Network(const ModelConfig& config)
   }
   if (!face_edges_) edge_kinds_.push_back(EdgeKind::kWorld);
 
-  const int l = config_.latent_size;
+  const int l = config_.latent_size, h = config_.mlp_hidden(), ho = config_.object_mlp_hidden();
   auto name_of = [&](int t) { return std::string(edge_kind_name(edge_kinds_[t])); };
   // Encoders (seed C.1.1).
-  encode_mesh_node_ = Mlp(layout_, "encoder/mesh_node", {sizes_.mesh_node}, l, l, true);
+  encode_mesh_node_ = Mlp(layout_, "encoder/mesh_node", {sizes_.mesh_node}, h, l, true);
   if (config_.graph.object_nodes) {
-    encode_object_node_ = Mlp(layout_, "encoder/object_node", {sizes_.object_node}, l, l, true);
+    encode_object_node_ = Mlp(layout_, "encoder/object_node", {sizes_.object_node}, ho, l, true);
   }
   for (size_t t = 0; t < edge_kinds_.size(); ++t) {
     const int width = edge_kinds_[t] == EdgeKind::kWorld ? sizes_.world_edge : sizes_.mesh_edge;
-    encode_edges_.push_back(Mlp(layout_, "encoder/" + name_of(t), {width}, l, l, true));
+    encode_edges_.push_back(Mlp(layout_, "encoder/" + name_of(t), {width}, h, l, true));
   }
   if (face_edges_) {
-    encode_face_ = Mlp(layout_, "encoder/face_edge", {sizes_.face_edge}, l, 3 * l, true);
+    encode_face_ = Mlp(layout_, "encoder/face_edge", {sizes_.face_edge}, h, 3 * l, true);
   }
   // Processor (seed C.1.2).
   for (int k = 0; k < config_.message_passing_steps; ++k) {
@@ -92,21 +92,21 @@ Network::Network(const ModelConfig& config)
     Step step;
     std::vector<int> mesh_blocks = {l};
     for (size_t t = 0; t < edge_kinds_.size(); ++t) {
-      step.edges.push_back(Mlp(layout_, prefix + name_of(t), {l, l, l}, l, l, true));
+      step.edges.push_back(Mlp(layout_, prefix + name_of(t), {l, l, l}, h, l, true));
       if (receiver_set(t) == NodeSet::kMesh) mesh_blocks.push_back(l);
     }
     if (face_edges_) {
-      step.face = Mlp(layout_, prefix + "face_edge", std::vector<int>(9, l), l, 3 * l, true);
+      step.face = Mlp(layout_, prefix + "face_edge", std::vector<int>(9, l), h, 3 * l, true);
       mesh_blocks.push_back(l);
     }
     if (config_.graph.object_nodes) {
-      step.object_node = Mlp(layout_, prefix + "object_node", {l, l}, l, l, true);
+      step.object_node = Mlp(layout_, prefix + "object_node", {l, l}, ho, l, true);
     }
-    step.mesh_node = Mlp(layout_, prefix + "mesh_node", mesh_blocks, l, l, true);
+    step.mesh_node = Mlp(layout_, prefix + "mesh_node", mesh_blocks, h, l, true);
     steps_.push_back(std::move(step));
   }
   // Decoder (seed C.1.3): no LayerNorm.
-  decoder_ = Mlp(layout_, "decoder/mesh_node", {l}, l, 3, false);
+  decoder_ = Mlp(layout_, "decoder/mesh_node", {l}, h, 3, false);
 }
 
 Normalizers Network::make_normalizers() const {
@@ -219,7 +219,7 @@ ConstMatrixView Network::forward(const float* params, const Normalizers& normali
     for (int t = 0; t < kinds; ++t) {
       const EdgeSet& edges = edges_of(graph, t);
       const Mlp& mlp = step.edges[t];
-      MatrixView z = ws.first.view(edges.size(), l);
+      MatrixView z = ws.first.view(edges.size(), mlp.hidden());
       gemm(cur.edges[t].get(), Transpose::kNo, mlp.first_weight(params, 0), Transpose::kNo, z,
            false);
       add_gathered_product(node_latents(cur, sender_set(t)).get(), mlp.first_weight(params, 1),
@@ -232,7 +232,7 @@ ConstMatrixView Network::forward(const float* params, const Normalizers& normali
     }
     if (face_edges_) {
       const Mlp& mlp = step.face;
-      MatrixView z = ws.first.zeros(faces, l);
+      MatrixView z = ws.first.zeros(faces, mlp.hidden());
       const ConstMatrixView q = cur.face.cget();
       for (int j = 0; j < 3; ++j) {
         add_product(q.middleCols(j * l, l), mlp.first_weight(params, 3 * j), z);
@@ -247,7 +247,7 @@ ConstMatrixView Network::forward(const float* params, const Normalizers& normali
     }
     // Node updates: [v, Σ incoming latents per edge type] with residuals.
     auto update_nodes = [&](NodeSet set, const Mlp& mlp, MlpCache& cache, Eigen::Index count) {
-      MatrixView z = ws.first.view(count, l);
+      MatrixView z = ws.first.view(count, mlp.hidden());
       gemm(node_latents(cur, set).get(), Transpose::kNo, mlp.first_weight(params, 0),
            Transpose::kNo, z, false);
       int block = 1;
@@ -282,31 +282,37 @@ ConstMatrixView Network::forward(const float* params, const Normalizers& normali
 
 double Network::forward_flops(const Graph& graph) const {
   const double l = config_.latent_size, m = config_.message_passing_steps;
+  const double h = config_.mlp_hidden(), ho = config_.object_mlp_hidden();
   const double nodes = graph.num_mesh_nodes(), objects = graph.object_nodes.rows();
   const double faces = graph.face_edges.size();
-  // An MLP over n rows whose first product is already formed: two more layers.
-  auto tail = [&](double n, double out) { return 2.0 * n * (l * l + l * out); };
-  auto dense = [&](double n, double in, double out) { return 2.0 * n * in * l + tail(n, out); };
-  double flops = dense(nodes, sizes_.mesh_node, l) + dense(nodes, l, 3);  // encoder, decoder
-  if (config_.graph.object_nodes) flops += dense(objects, sizes_.object_node, l);
-  if (face_edges_) flops += dense(faces, sizes_.face_edge, 3 * l);
+  // An MLP of hidden width `hidden` over n rows whose first product is already formed: two more
+  // layers.
+  auto tail = [&](double n, double out, double hidden) {
+    return 2.0 * n * (hidden * hidden + hidden * out);
+  };
+  auto dense = [&](double n, double in, double out, double hidden) {
+    return 2.0 * n * in * hidden + tail(n, out, hidden);
+  };
+  double flops = dense(nodes, sizes_.mesh_node, l, h) + dense(nodes, l, 3, h);  // encoder, decoder
+  if (config_.graph.object_nodes) flops += dense(objects, sizes_.object_node, l, ho);
+  if (face_edges_) flops += dense(faces, sizes_.face_edge, 3 * l, h);
   double per_step = 0.0;
   int mesh_blocks = 1 + (face_edges_ ? 1 : 0);
   for (int t = 0; t < static_cast<int>(edge_kinds_.size()); ++t) {
     const double edges = edges_of(graph, t).size();
-    flops += dense(edges, edges_of(graph, t).features.cols(), l);
+    flops += dense(edges, edges_of(graph, t).features.cols(), l, h);
     const double senders = sender_set(t) == NodeSet::kMesh ? nodes : objects;
     const double receivers = receiver_set(t) == NodeSet::kMesh ? nodes : objects;
     // A gathered block costs a product per node or per edge, whichever is fewer (ops.h).
-    per_step += 2.0 * (edges + std::min(edges, senders) + std::min(edges, receivers)) * l * l +
-                tail(edges, l);
+    per_step += 2.0 * (edges + std::min(edges, senders) + std::min(edges, receivers)) * l * h +
+                tail(edges, l, h);
     if (receiver_set(t) == NodeSet::kMesh) ++mesh_blocks;
   }
   if (face_edges_) {
-    per_step += 2.0 * 3 * (faces + 2 * std::min(faces, nodes)) * l * l + tail(faces, 3 * l);
+    per_step += 2.0 * 3 * (faces + 2 * std::min(faces, nodes)) * l * h + tail(faces, 3 * l, h);
   }
-  if (config_.graph.object_nodes) per_step += 2.0 * objects * 2 * l * l + tail(objects, l);
-  per_step += 2.0 * nodes * mesh_blocks * l * l + tail(nodes, l);
+  if (config_.graph.object_nodes) per_step += 2.0 * objects * 2 * l * ho + tail(objects, l, ho);
+  per_step += 2.0 * nodes * mesh_blocks * l * h + tail(nodes, l, h);
   return flops + m * per_step;
 }
 

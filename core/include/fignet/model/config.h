@@ -40,7 +40,12 @@ struct ModelConfig {
   GraphConfig graph;
   int latent_size = 128;           // L: hidden and output width of every MLP (seed C.2)
   int message_passing_steps = 10;  // M, unshared weights (seed C.1.2)
-  double noise_std = 3e-4;         // random-walk noise at the last input position, metres
+  // Width of the two hidden layers of every MLP; 0: latent_size (seed C.2). Latents stay L wide.
+  int hidden_size = 0;
+  // Of the object-node MLPs alone (encoder and processor); 0: as the others. They run on one row
+  // per body, a few per scene, so a wider one costs next to nothing beside the mesh's MLPs.
+  int object_hidden_size = 0;
+  double noise_std = 3e-4;  // random-walk noise at the last input position, metres
   NoiseKind noise = NoiseKind::kVertex;
   // Share of the last input position's noise that the training target undoes: 0 the velocity
   // noise only (GNS, the paper: a displaced body keeps its offset), 1 the position too (the model
@@ -82,6 +87,12 @@ struct ModelConfig {
              {"floor_restitution", &floor_restitution}}};
   }
   std::uint64_t seed = 0;  // parameter initialisation
+
+  // The hidden width of the MLPs, and of the object-node MLPs (0 fields resolved).
+  int mlp_hidden() const { return hidden_size > 0 ? hidden_size : latent_size; }
+  int object_mlp_hidden() const {
+    return object_hidden_size > 0 ? object_hidden_size : mlp_hidden();
+  }
 
   // "paper": L = 128, M = 10, d_c = 0.1 m (seed C.2). "small": L = 64, M = 5, about 10x fewer
   // FLOPs, for quick training and fast inference. Throws ConfigError for another name.
