@@ -21,12 +21,15 @@ struct Variant {
   CollisionEdges collisions;
   bool object_nodes;
   int latent_size, steps;
+  int hidden_size = 0, object_hidden_size = 0;  // 0: the latent width
 };
 
 ModelConfig config_of(const Variant& v) {
   ModelConfig config = ModelConfig::preset_named("small");
   config.latent_size = v.latent_size;
   config.message_passing_steps = v.steps;
+  config.hidden_size = v.hidden_size;
+  config.object_hidden_size = v.object_hidden_size;
   config.graph.collisions = v.collisions;
   config.graph.object_nodes = v.object_nodes;
   config.graph.collision_radius = 0.3;
@@ -106,7 +109,8 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(Variant{"face_object", CollisionEdges::kFaceFace, true, 16, 2},
                       Variant{"face_no_object", CollisionEdges::kFaceFace, false, 16, 2},
                       Variant{"node_node", CollisionEdges::kNodeNode, true, 16, 2},
-                      Variant{"small_preset", CollisionEdges::kFaceFace, true, 64, 5}),
+                      Variant{"small_preset", CollisionEdges::kFaceFace, true, 64, 5},
+                      Variant{"wider_hidden", CollisionEdges::kFaceFace, true, 16, 2, 24, 40}),
     [](const auto& info) { return std::string(info.param.name); });
 
 // Trajectories of a few random scenes moving at constant velocity.
