@@ -143,11 +143,18 @@ frame + 1. Returns a dict: "accelerations" (vertices of all objects, 3) as finit
 x[t+1] − 2x[t] + x[t−1] in metres, and the next "positions" (objects, 3) and "quaternions"
 (objects, 4) as (w, x, y, z) after the rigid fit.)")
       .def("__repr__", [](const Model& model) {
+        const ModelConfig& config = model.config();
+        // Hidden widths only where a grown model's differ from the latent width.
+        std::string widths;
+        if (config.mlp_hidden() != config.latent_size ||
+            config.object_mlp_hidden() != config.latent_size)
+          widths = fmt::format(", hidden {}, object hidden {}", config.mlp_hidden(),
+                               config.object_mlp_hidden());
         return fmt::format(
-            "<fignet.Model: preset {}, latent {}, {} message-passing steps, {} "
+            "<fignet.Model: preset {}, latent {}{}, {} message-passing steps, {} "
             "parameters, dt {:.6g} s>",
-            model.config().preset, model.config().latent_size, model.config().message_passing_steps,
-            model.parameters().size(), model.config().time_step);
+            config.preset, config.latent_size, widths, config.message_passing_steps,
+            model.parameters().size(), config.time_step);
       });
 
   m.def(

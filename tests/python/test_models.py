@@ -22,6 +22,21 @@ def test_a_loaded_model_describes_itself(model):
     np.testing.assert_allclose(model.config["floor_restitution"], (0.5, 0.5), rtol=1e-6)
 
 
+def test_a_widened_model_names_its_hidden_widths(tmp_path, cli, model):
+    # The shipped model's hidden layers are its latent width: nothing more to say.
+    assert "hidden" not in repr(model)
+    data, out = tmp_path / "scenes.h5", tmp_path / "wide.h5"
+    fignet.generate("movi-a", count=2, seed=5, frames=8, path=data)
+    train = [cli, "train", "--data", data, "--set", "batch_size=2", "--set", "statistics_warmup=0",
+             "--threads", "1", "--out", out]
+    subprocess.run([*train, "--preset", "small", "--steps", "1"], check=True, capture_output=True)
+    subprocess.run([*train, "--resume", "--steps", "2", "--widen-object-hidden", "96"], check=True,
+                   capture_output=True)
+    wide = fignet.load_model(out)
+    assert wide.config["hidden_size"] == 0 and wide.config["object_hidden_size"] == 96
+    assert "latent 64, hidden 64, object hidden 96," in repr(wide)
+
+
 def test_evaluation_equals_fignet_eval_on_the_same_file(tmp_path, cli, model, source_dir):
     data = tmp_path / "scenes.h5"
     truths = fignet.generate("movi-a", count=2, seed=21, frames=16, path=data)
