@@ -220,7 +220,9 @@ TEST(Widen, TheWiderNetworkPredictsWhatTheTrainedOneDidAndTrainsOn) {
           ASSERT_EQ(wider.state.second_moment[at], state.second_moment[from]) << name;
           ASSERT_EQ(wider.state.averaged_parameters[at], state.averaged_parameters[from]) << name;
         } else {
-          if (r >= old.rows) ASSERT_EQ(model.parameters()[at], 0.0f) << name;
+          if (r >= old.rows) {
+            ASSERT_EQ(model.parameters()[at], 0.0f) << name;
+          }
           drawn = drawn || model.parameters()[at] != 0.0f;
           ASSERT_EQ(wider.state.second_moment[at], 0.0f) << name;
           ASSERT_EQ(wider.state.averaged_parameters[at], model.parameters()[at]) << name;
